@@ -1,0 +1,12 @@
+#pragma once
+// Each subcommand lives in its own file and registers itself on the root app. A subcommand's
+// callback does the work; user errors are thrown as neraf::Error and turned into
+// "error: ..." + exit 1 by main().
+#include <CLI/CLI.hpp>
+
+namespace neraf::cli {
+
+void register_metrics(CLI::App& app);
+void register_auralize(CLI::App& app);
+
+}  // namespace neraf::cli

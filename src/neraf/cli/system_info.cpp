@@ -1,0 +1,31 @@
+#include "neraf/cli/system_info.h"
+
+#include <torch/torch.h>
+
+#include <fstream>
+
+namespace neraf::cli {
+
+std::string loaded_blas_library() {
+  // A product large enough to go through BLAS (small ones may take a native path).
+  auto a = torch::ones({64, 64});
+  (void)torch::mm(a, a);
+  std::ifstream maps("/proc/self/maps");
+  std::string line;
+  while (std::getline(maps, line)) {
+    const auto slash = line.find('/');
+    if (slash == std::string::npos) continue;
+    const std::string path = line.substr(slash);
+    if (path.find("blas") != std::string::npos) return path;
+  }
+  return "";
+}
+
+std::string version_text() {
+  const std::string blas = loaded_blas_library();
+  return std::string("neraf 0.1.0\nLibTorch ") + TORCH_VERSION + ", " +
+         std::to_string(torch::get_num_threads()) + " threads\nBLAS " +
+         (blas.empty() ? "(none loaded)" : blas);
+}
+
+}  // namespace neraf::cli

@@ -1,0 +1,14 @@
+#pragma once
+#include <string>
+
+namespace neraf::cli {
+
+// "neraf 0.1.0" plus LibTorch version, thread count and the BLAS library actually loaded.
+std::string version_text();
+
+// Path of the BLAS shared library mapped into this process after a matrix product, read from
+// /proc/self/maps (empty if none is found). LibTorch's products are ~16× slower without
+// OpenBLAS's OpenMP build, so `neraf --version` reports which one is really in use.
+std::string loaded_blas_library();
+
+}  // namespace neraf::cli

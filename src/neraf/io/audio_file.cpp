@@ -1,0 +1,146 @@
+#include "neraf/io/audio_file.h"
+
+#include <sndfile.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+#include "neraf/io/atomic_file.h"
+#include "neraf/util/error.h"
+
+namespace fs = std::filesystem;
+
+namespace neraf::io {
+namespace {
+
+// Owns an SNDFILE* so every early return / throw closes the file.
+struct SndCloser {
+  void operator()(SNDFILE* f) const {
+    if (f) sf_close(f);
+  }
+};
+using SndHandle = std::unique_ptr<SNDFILE, SndCloser>;
+
+// Frames moved per libsndfile call: bounds the interleaved scratch buffer for long files.
+constexpr sf_count_t kChunkFrames = 1 << 16;
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+}  // namespace
+
+AudioBuffer read_audio(const std::string& path) {
+  std::error_code ec;
+  require(fs::exists(path, ec), path + ": no such file; check the path");
+  require(!fs::is_directory(path, ec), path + ": is a folder, expected an audio file");
+  const auto bytes = fs::file_size(path, ec);
+  require(ec || bytes > 0, path + ": the file is empty (0 bytes); expected an audio file (WAV, FLAC, ...)");
+
+  SF_INFO info{};
+  SndHandle file(sf_open(path.c_str(), SFM_READ, &info));
+  if (!file) {
+    // sf_strerror(nullptr) reports why the last sf_open failed (unknown format, truncated header...).
+    throw Error(path + ": not an audio file libsndfile can read (" + sf_strerror(nullptr) +
+                "); expected WAV, FLAC or another libsndfile format");
+  }
+  require(info.channels > 0, path + ": the audio file declares no channels; re-export it");
+  require(info.samplerate > 0, path + ": the audio file declares no sample rate; re-export it");
+  require(info.frames > 0, path + ": the audio file is empty (0 frames); expected a recording");
+
+  // Float files are returned as stored; integer files are scaled to [-1, 1) by libsndfile (its
+  // default normalisation).
+  AudioBuffer out;
+  out.sample_rate = info.samplerate;
+  const int nc = info.channels;
+  out.channels.assign(nc, std::vector<float>(static_cast<size_t>(info.frames)));
+
+  std::vector<float> interleaved(static_cast<size_t>(std::min(info.frames, kChunkFrames)) * nc);
+  sf_count_t done = 0;
+  while (done < info.frames) {
+    const sf_count_t want = std::min(kChunkFrames, info.frames - done);
+    const sf_count_t got = sf_readf_float(file.get(), interleaved.data(), want);
+    if (got <= 0) break;
+    for (sf_count_t i = 0; i < got; ++i) {
+      for (int c = 0; c < nc; ++c) out.channels[c][done + i] = interleaved[size_t(i) * nc + c];
+    }
+    done += got;
+  }
+  if (done < info.frames) {
+    throw Error(path + ": truncated audio file (header announces " + std::to_string(info.frames) +
+                " frames, only " + std::to_string(done) + " could be read); re-export or re-copy it");
+  }
+  return out;
+}
+
+void write_audio(const std::string& path, const AudioBuffer& audio, AudioFormat format) {
+  require(audio.num_channels() > 0, path + ": nothing to write (no audio channels)");
+  require(audio.sample_rate > 0, path + ": cannot write audio with sample rate " +
+                                     std::to_string(audio.sample_rate) + " Hz; it must be positive");
+  const size_t n = audio.channels[0].size();
+  for (const auto& ch : audio.channels) {
+    require(ch.size() == n, path + ": all audio channels must have the same length to be written");
+    // A NaN/Inf sample would be written silently and poison every later computation on the file.
+    for (float v : ch) {
+      require(std::isfinite(v), path + ": refusing to write audio containing NaN or infinite samples");
+    }
+  }
+
+  if (format == AudioFormat::from_extension) {
+    format = lower_extension(path) == ".flac" ? AudioFormat::flac_pcm24 : AudioFormat::wav_float;
+  }
+  int sf_format = 0;
+  switch (format) {
+    case AudioFormat::wav_float: sf_format = SF_FORMAT_WAV | SF_FORMAT_FLOAT; break;
+    case AudioFormat::wav_pcm16: sf_format = SF_FORMAT_WAV | SF_FORMAT_PCM_16; break;
+    case AudioFormat::flac_pcm24:
+      sf_format = SF_FORMAT_FLAC | SF_FORMAT_PCM_24;
+      require(audio.num_channels() <= 8,
+              path + ": FLAC holds at most 8 channels; write " +
+                  std::to_string(audio.num_channels()) + " channels as WAV instead");
+      break;
+    case AudioFormat::from_extension: break;  // resolved above
+  }
+
+  const int nc = audio.num_channels();
+  write_atomically(path, [&](const std::string& tmp) {
+    SF_INFO info{};
+    info.samplerate = audio.sample_rate;
+    info.channels = nc;
+    info.format = sf_format;
+    require(sf_format_check(&info) != 0,
+            path + ": libsndfile cannot store " + std::to_string(nc) + " channels at " +
+                std::to_string(audio.sample_rate) + " Hz in this format; choose WAV");
+    SndHandle file(sf_open(tmp.c_str(), SFM_WRITE, &info));
+    if (!file) {
+      throw Error(path + ": cannot open for writing (" + sf_strerror(nullptr) +
+                  "); choose a writable output path");
+    }
+    // Integer formats: clip out-of-range samples instead of letting them wrap around.
+    sf_command(file.get(), SFC_SET_CLIPPING, nullptr, SF_TRUE);
+
+    std::vector<float> interleaved(std::min<size_t>(n, kChunkFrames) * nc);
+    size_t done = 0;
+    while (done < n) {
+      const size_t count = std::min<size_t>(kChunkFrames, n - done);
+      for (size_t i = 0; i < count; ++i) {
+        for (int c = 0; c < nc; ++c) interleaved[i * nc + c] = audio.channels[c][done + i];
+      }
+      const sf_count_t wrote = sf_writef_float(file.get(), interleaved.data(), sf_count_t(count));
+      if (wrote != sf_count_t(count)) {
+        throw Error(path + ": write failed (" + sf_strerror(file.get()) + "); free disk space and retry");
+      }
+      done += count;
+    }
+    // Close before the rename so the header is complete on disk.
+    const int rc = sf_close(file.release());
+    require(rc == 0, path + ": could not finish writing the file (" + sf_error_number(rc) +
+                         "); free disk space and retry");
+  });
+}
+
+}  // namespace neraf::io

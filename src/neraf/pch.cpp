@@ -1,0 +1,1 @@
+// Compiled once to build the LibTorch precompiled header shared by all torch-using targets.
