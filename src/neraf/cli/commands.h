@@ -8,5 +8,10 @@ namespace neraf::cli {
 
 void register_metrics(CLI::App& app);
 void register_auralize(CLI::App& app);
+void register_train(CLI::App& app);
+void register_render(CLI::App& app);
+void register_eval(CLI::App& app);
+void register_info(CLI::App& app);
+void register_synth(CLI::App& app);
 
 }  // namespace neraf::cli

@@ -43,6 +43,11 @@ int main(int argc, char** argv) {
 
   neraf::cli::register_metrics(app);
   neraf::cli::register_auralize(app);
+  neraf::cli::register_train(app);
+  neraf::cli::register_render(app);
+  neraf::cli::register_eval(app);
+  neraf::cli::register_info(app);
+  neraf::cli::register_synth(app);
 
   try {
     app.parse(argc, argv);

@@ -8,12 +8,15 @@
 #include <string>
 #include <vector>
 
+#include "neraf/data/problem.h"
+
 namespace neraf::data {
 
 struct Intrinsics {  // OPENCV camera model, pixels
   double fx = 0, fy = 0, cx = 0, cy = 0;
   int width = 0, height = 0;
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0;  // distortion (zero for the simulator)
+  double k3 = 0;  // third radial coefficient (nerfstudio OPENCV also carries it; usually 0)
 };
 
 struct ImageSplit {
@@ -32,6 +35,36 @@ struct ImageSet {
   torch::Tensor world_transform;  // [3, 4] float64: [R | t] before scaling
   double world_scale = 1.0;
   std::string source;             // the transforms.json it was read from
+  std::string eval_mode;          // the split rule used: "filename" | "fraction" | "lists"
 };
+
+struct ImageLoadOptions {
+  // "auto": "filename" when every frame's file name contains "train_" or "eval_", else
+  // "fraction". "filename" | "fraction" force one rule. transforms.json's own
+  // "train_filenames"/"val_filenames"/"test_filenames" lists win over both (nerfstudio does so).
+  std::string eval_mode = "auto";
+  double train_fraction = 0.9;  // "fraction": train = floor(linspace(0, N-1, ceil(f·N)))
+  // "" = transforms.json's "orientation_override" if present, else "up"; or "up" | "none".
+  std::string orientation;
+  bool auto_scale = true;   // scale so that the largest |t| component of the poses is 1
+  bool load_pixels = true;  // false: check the image headers (sizes) only; `images` stays undefined
+  bool progress = true;
+};
+
+// Reads a nerfstudio transforms.json (a path to the file, or the folder holding it) the way
+// nerfstudio's NerfstudioDataParser does: frames sorted by file path, OPENCV intrinsics global or
+// per frame, poses normalised over all frames (orientation, centring on the mean camera position,
+// auto-scale) before the split. Every problem (missing or unreadable image, size ≠ intrinsics,
+// NaN / non-rigid camera matrix, empty train split) is reported with the frame index and file;
+// all of them are collected first and then thrown as one neraf::Error.
+ImageSet load_transforms_json(const std::string& path, const ImageLoadOptions& options = {});
+
+// Same checks, without throwing: appends the problems to `problems` and returns what could be
+// read (pixels are never decoded here).
+ImageSet check_transforms_json(const std::string& path, const ImageLoadOptions& options,
+                               ProblemList& problems);
+
+// Maps dataset-frame points into the normalised frame: scale · (R p + t).
+torch::Tensor to_normalized_world(const ImageSet& set, const torch::Tensor& points);  // [N,3] f64
 
 }  // namespace neraf::data

@@ -5,6 +5,7 @@
 // { x = istft(S·a); r = stft(x); a = r − m·prev; a /= |a| + 1e-16; prev = r }; final istft(S·a).
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "neraf/dsp/stft.h"
 
@@ -18,8 +19,26 @@ struct GriffinLimOptions {
   std::optional<size_t> length;  // output length; default hop*(T-1)
 };
 
-// magnitude: [n_freq, n_frames] linear magnitude (power 1).
+// magnitude: [n_freq, n_frames] linear magnitude (power 1). Returns the waveform, length
+// options.length or hop·(T−1). p.center must be true (torchaudio's griffinlim always centres).
+//
+// The initial phases follow the recipe of torch's CPU generator for torch.rand(complex) after
+// torch.manual_seed(seed) (not verified against torch here; NeRAF itself draws them on CUDA):
+// std::mt19937 seeded with the low 32 bits of `seed`, each value (next() & 0xFFFFFF)·2^-24, drawn
+// in memory order [freq][frame][re, im].
+// `length` is used inside the iterations as torchaudio does when 1 + length/hop == n_frames (the
+// only lengths torch accepts there); any other length only pads/cuts the final waveform.
+// Results do not depend on the number of OpenMP threads (frames run in parallel, sums in a fixed
+// order).
 std::vector<float> griffin_lim(const Matrix& magnitude, const StftParams& p,
                                const GriffinLimOptions& options = {});
+
+// Several channels of one spectrogram (e.g. binaural [2, F, T]); all must have the same shape.
+// The initial phases are drawn as for one [C, F, T] tensor: channel 0 first, then channel 1, ...
+// (so channel 0 equals the single-channel call with the same seed). All channels' frames share one
+// OpenMP work pool.
+std::vector<std::vector<float>> griffin_lim(const std::vector<Matrix>& magnitudes,
+                                            const StftParams& p,
+                                            const GriffinLimOptions& options = {});
 
 }  // namespace neraf::dsp

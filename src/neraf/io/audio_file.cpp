@@ -3,7 +3,9 @@
 #include <sndfile.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <memory>
 
@@ -28,8 +30,32 @@ constexpr sf_count_t kChunkFrames = 1 << 16;
 
 std::string lower_extension(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
   return ext;
+}
+
+// libsndfile opens a WAV/AIFF whose data chunk is cut short (an interrupted copy or recording)
+// and silently returns only the frames present; it only notes "data : <declared> (should be
+// <actual>)" in its log. A declared size larger than what is there means the file was truncated.
+// 0 and 0xFFFFFFFF-like sizes are placeholders of streamed recordings, not truncation.
+bool data_chunk_truncated(SNDFILE* file, int64_t* declared, int64_t* actual) {
+  std::string log(1 << 14, '\0');
+  sf_command(file, SFC_GET_LOG_INFO, log.data(), static_cast<int>(log.size()));
+  for (size_t pos = log.find("data :"); pos != std::string::npos;
+       pos = log.find("data :", pos + 1)) {
+    const size_t eol = log.find('\n', pos);
+    const std::string line =
+        log.substr(pos, eol == std::string::npos ? std::string::npos : eol - pos);
+    long long d = 0, a = 0;
+    if (std::sscanf(line.c_str(), "data : %lld (should be %lld)", &d, &a) == 2 && d > a && d > 0 &&
+        d < 0xFFFFFF00LL) {
+      *declared = d;
+      *actual = a;
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace
@@ -39,18 +65,26 @@ AudioBuffer read_audio(const std::string& path) {
   require(fs::exists(path, ec), path + ": no such file; check the path");
   require(!fs::is_directory(path, ec), path + ": is a folder, expected an audio file");
   const auto bytes = fs::file_size(path, ec);
-  require(ec || bytes > 0, path + ": the file is empty (0 bytes); expected an audio file (WAV, FLAC, ...)");
+  require(ec || bytes > 0,
+          path + ": the file is empty (0 bytes); expected an audio file (WAV, FLAC, ...)");
 
   SF_INFO info{};
   SndHandle file(sf_open(path.c_str(), SFM_READ, &info));
   if (!file) {
-    // sf_strerror(nullptr) reports why the last sf_open failed (unknown format, truncated header...).
+    // sf_strerror(nullptr) reports why the last sf_open failed (unknown format, truncated
+    // header...).
     throw Error(path + ": not an audio file libsndfile can read (" + sf_strerror(nullptr) +
                 "); expected WAV, FLAC or another libsndfile format");
   }
   require(info.channels > 0, path + ": the audio file declares no channels; re-export it");
   require(info.samplerate > 0, path + ": the audio file declares no sample rate; re-export it");
   require(info.frames > 0, path + ": the audio file is empty (0 frames); expected a recording");
+  int64_t declared = 0, actual = 0;
+  if (data_chunk_truncated(file.get(), &declared, &actual)) {
+    throw Error(path + ": truncated audio file (its header announces " + std::to_string(declared) +
+                " bytes of samples, only " + std::to_string(actual) +
+                " are there); re-export or re-copy it");
+  }
 
   // Float files are returned as stored; integer files are scaled to [-1, 1) by libsndfile (its
   // default normalisation).
@@ -72,7 +106,8 @@ AudioBuffer read_audio(const std::string& path) {
   }
   if (done < info.frames) {
     throw Error(path + ": truncated audio file (header announces " + std::to_string(info.frames) +
-                " frames, only " + std::to_string(done) + " could be read); re-export or re-copy it");
+                " frames, only " + std::to_string(done) +
+                " could be read); re-export or re-copy it");
   }
   return out;
 }
@@ -80,13 +115,16 @@ AudioBuffer read_audio(const std::string& path) {
 void write_audio(const std::string& path, const AudioBuffer& audio, AudioFormat format) {
   require(audio.num_channels() > 0, path + ": nothing to write (no audio channels)");
   require(audio.sample_rate > 0, path + ": cannot write audio with sample rate " +
-                                     std::to_string(audio.sample_rate) + " Hz; it must be positive");
+                                     std::to_string(audio.sample_rate) +
+                                     " Hz; it must be positive");
   const size_t n = audio.channels[0].size();
   for (const auto& ch : audio.channels) {
     require(ch.size() == n, path + ": all audio channels must have the same length to be written");
     // A NaN/Inf sample would be written silently and poison every later computation on the file.
     for (float v : ch) {
-      require(std::isfinite(v), path + ": refusing to write audio containing NaN or infinite samples");
+      if (!std::isfinite(v)) {
+        throw Error(path + ": refusing to write audio containing NaN or infinite samples");
+      }
     }
   }
 
@@ -95,15 +133,20 @@ void write_audio(const std::string& path, const AudioBuffer& audio, AudioFormat 
   }
   int sf_format = 0;
   switch (format) {
-    case AudioFormat::wav_float: sf_format = SF_FORMAT_WAV | SF_FORMAT_FLOAT; break;
-    case AudioFormat::wav_pcm16: sf_format = SF_FORMAT_WAV | SF_FORMAT_PCM_16; break;
+    case AudioFormat::wav_float:
+      sf_format = SF_FORMAT_WAV | SF_FORMAT_FLOAT;
+      break;
+    case AudioFormat::wav_pcm16:
+      sf_format = SF_FORMAT_WAV | SF_FORMAT_PCM_16;
+      break;
     case AudioFormat::flac_pcm24:
       sf_format = SF_FORMAT_FLAC | SF_FORMAT_PCM_24;
-      require(audio.num_channels() <= 8,
-              path + ": FLAC holds at most 8 channels; write " +
-                  std::to_string(audio.num_channels()) + " channels as WAV instead");
+      require(audio.num_channels() <= 8, path + ": FLAC holds at most 8 channels; write " +
+                                             std::to_string(audio.num_channels()) +
+                                             " channels as WAV instead");
       break;
-    case AudioFormat::from_extension: break;  // resolved above
+    case AudioFormat::from_extension:
+      break;  // resolved above
   }
 
   const int nc = audio.num_channels();
@@ -112,9 +155,9 @@ void write_audio(const std::string& path, const AudioBuffer& audio, AudioFormat 
     info.samplerate = audio.sample_rate;
     info.channels = nc;
     info.format = sf_format;
-    require(sf_format_check(&info) != 0,
-            path + ": libsndfile cannot store " + std::to_string(nc) + " channels at " +
-                std::to_string(audio.sample_rate) + " Hz in this format; choose WAV");
+    require(sf_format_check(&info) != 0, path + ": libsndfile cannot store " + std::to_string(nc) +
+                                             " channels at " + std::to_string(audio.sample_rate) +
+                                             " Hz in this format; choose WAV");
     SndHandle file(sf_open(tmp.c_str(), SFM_WRITE, &info));
     if (!file) {
       throw Error(path + ": cannot open for writing (" + sf_strerror(nullptr) +
@@ -132,7 +175,8 @@ void write_audio(const std::string& path, const AudioBuffer& audio, AudioFormat 
       }
       const sf_count_t wrote = sf_writef_float(file.get(), interleaved.data(), sf_count_t(count));
       if (wrote != sf_count_t(count)) {
-        throw Error(path + ": write failed (" + sf_strerror(file.get()) + "); free disk space and retry");
+        throw Error(path + ": write failed (" + sf_strerror(file.get()) +
+                    "); free disk space and retry");
       }
       done += count;
     }

@@ -13,8 +13,8 @@
 namespace neraf::sim {
 
 // Measured head-related impulse responses (MIT KEMAR from libmysofa's default.sofa), resampled by
-// libmysofa to `sample_rate` and loudness-normalised by it (mysofa_open). Every measured direction is
-// copied into memory at construction; `lookup` returns the NEAREST measured direction (no
+// libmysofa to `sample_rate` and loudness-normalised by it (mysofa_open). Every measured direction
+// is copied into memory at construction; `lookup` returns the NEAREST measured direction (no
 // interpolation between measurements, so no comb filtering from mixing different ITDs).
 // Thread-safe after construction (lookups are const and touch no libmysofa state).
 class Hrtf {

@@ -61,6 +61,9 @@ struct RandomMicrophones {  // RAF-like: omni microphones at random positions
   int count = 200;
   double min_height_m = 0.8, max_height_m = 1.8;
   double wall_margin_m = 0.4;
+  // Headings of the binaural (SoundSpaces layout) receivers at every random position; the RAF
+  // layout's microphones are omni and ignore them.
+  std::vector<double> headings_deg{0, 90, 180, 270};
 };
 
 struct Microphones {
@@ -75,10 +78,14 @@ struct Cameras {  // placed near the walls looking at the room centre with a ran
   double fov_deg = 90;
   double wall_margin_m = 0.3;
   double look_jitter_m = 0.5;
+  double min_height_m = 0.8, max_height_m = 2.0;  // camera heights (clipped to the room)
+  int supersampling = 2;  // n×n rays per pixel, averaged (anti-aliases texture edges)
 };
 
 struct Light {
-  Vec3 position;      // a point light (defaults to just below the ceiling centre)
+  // A point light. Scene JSON without light.position puts it at default_light_position(size);
+  // Scene values built in C++ must set it.
+  Vec3 position;
   double intensity = 1.0;
   double ambient = 0.25;
 };
@@ -89,10 +96,27 @@ struct Acoustics {
   double rir_length_s = 1.0;   // length of every written RIR
 };
 
+// Materials every scene has unless it redefines them: the names RoomSurfaces uses by default.
+inline std::map<std::string, Material> default_materials() {
+  std::map<std::string, Material> m;
+  m["floor"].albedo = {0.55, 0.45, 0.35};
+  m["floor"].absorption = {0.02, 0.03, 0.04, 0.05, 0.05, 0.06, 0.06};
+  m["ceiling"].albedo = {0.85, 0.85, 0.85};
+  m["ceiling"].absorption = {0.15, 0.20, 0.25, 0.30, 0.30, 0.30, 0.30};
+  m["wall"].albedo = {0.75, 0.72, 0.68};
+  m["wall"].absorption = {0.05, 0.06, 0.07, 0.08, 0.09, 0.10, 0.10};
+  return m;
+}
+
+// Just below the ceiling centre.
+inline Vec3 default_light_position(Vec3 room_size) {
+  return {0.5 * room_size.x, room_size.y - 0.15, 0.5 * room_size.z};
+}
+
 struct Scene {
   std::string name = "scene";
   Vec3 size{5, 3, 4};
-  std::map<std::string, Material> materials;
+  std::map<std::string, Material> materials = default_materials();
   RoomSurfaces surfaces;
   std::vector<Box> furniture;
   std::vector<Source> sources;

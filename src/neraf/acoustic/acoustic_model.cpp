@@ -1,0 +1,138 @@
+#include "neraf/acoustic/acoustic_model.h"
+
+#include <torch/torch.h>
+
+#include "neraf/util/error.h"
+
+namespace neraf::acoustic {
+
+GridMode parse_grid_mode(const std::string& name) {
+  if (name == "sampled") return GridMode::kSampled;
+  if (name == "zeros") return GridMode::kZeros;
+  if (name == "none") return GridMode::kNone;
+  throw Error("acoustic grid_mode: unknown value '" + name + "': use sampled, zeros or none");
+}
+
+std::string to_string(GridMode mode) {
+  switch (mode) {
+    case GridMode::kSampled:
+      return "sampled";
+    case GridMode::kZeros:
+      return "zeros";
+    case GridMode::kNone:
+      return "none";
+  }
+  return "sampled";
+}
+
+AcousticModelOptions acoustic_preset(const std::string& name, int64_t n_channels, int64_t n_freq,
+                                     int64_t max_len) {
+  AcousticModelOptions o;
+  o.max_len = max_len;
+  if (name == "paper") {
+    o.grid.resolution = 128;
+    o.grid.cells_per_update = 4096;
+    o.resnet = resnet3d_paper_options();
+    o.nacf = nacf_paper_options(n_channels, n_freq, resnet3d_out_features(o.resnet));
+  } else if (name == "cpu") {
+    o.grid.resolution = 32;
+    o.grid.cells_per_update = 4096;
+    o.resnet = resnet3d_cpu_options();
+    o.nacf = nacf_cpu_options(n_channels, n_freq, resnet3d_out_features(o.resnet));
+    o.nacf.bf16 = true;
+  } else {
+    throw Error("preset: unknown acoustic preset '" + name + "': use cpu or paper");
+  }
+  return o;
+}
+
+AcousticModelImpl::AcousticModelImpl(AcousticModelOptions options) : options_(std::move(options)) {
+  require(options_.max_len >= 2, "audio max_len: must be at least 2 frames");
+  if (options_.grid_mode == GridMode::kNone) {
+    options_.nacf.grid_features = 0;
+  } else {
+    resnet3d_ = register_module("resnet3d", ResNet3d(options_.resnet));
+    options_.nacf.grid_features = resnet3d_->out_features();
+  }
+  field_ = register_module("field", Nacf(options_.nacf));
+}
+
+torch::Tensor AcousticModelImpl::scene_feature(const torch::Tensor& grid) {
+  if (options_.grid_mode == GridMode::kNone) return {};
+  const int64_t s = options_.grid.resolution;
+  torch::Tensor input;
+  if (options_.grid_mode == GridMode::kZeros) {
+    const auto device = resnet3d_->parameters().front().device();
+    input = torch::zeros({1, options_.resnet.in_channels, s, s, s},
+                         torch::dtype(torch::kFloat32).device(device));
+  } else {
+    TORCH_CHECK(grid.defined() && grid.dim() == 4 && grid.size(0) == options_.resnet.in_channels,
+                "AcousticModel: grid must be [", options_.resnet.in_channels, ", S, S, S]");
+    input = grid.unsqueeze(0);
+  }
+  return resnet3d_->forward(input).squeeze(0);  // [G]
+}
+
+torch::Tensor AcousticModelImpl::forward_with_feature(const torch::Tensor& feature,
+                                                      const torch::Tensor& t,
+                                                      const torch::Tensor& mic_norm,
+                                                      const torch::Tensor& src_norm,
+                                                      const torch::Tensor& rot) {
+  const auto h = nacf_input(feature, t, options_.max_len, mic_norm, src_norm, rot);
+  return field_->forward(h);  // [B, C, F]
+}
+
+torch::Tensor AcousticModelImpl::forward(const torch::Tensor& grid, const torch::Tensor& t,
+                                         const torch::Tensor& mic_norm,
+                                         const torch::Tensor& src_norm, const torch::Tensor& rot) {
+  return forward_with_feature(scene_feature(grid), t, mic_norm, src_norm, rot);
+}
+
+namespace {
+
+// Restores a module's train/eval flag on scope exit.
+class EvalScope {
+ public:
+  explicit EvalScope(torch::nn::Module& m) : m_(m), was_training_(m.is_training()) { m_.eval(); }
+  ~EvalScope() { m_.train(was_training_); }
+  EvalScope(const EvalScope&) = delete;
+  EvalScope& operator=(const EvalScope&) = delete;
+
+ private:
+  torch::nn::Module& m_;
+  bool was_training_;
+};
+
+torch::Tensor pose_row(const torch::Tensor& x, const char* name) {
+  TORCH_CHECK(x.numel() == 3, "render_stft: ", name, " must have 3 values, got ", x.sizes());
+  return x.reshape({1, 3});
+}
+
+}  // namespace
+
+torch::Tensor AcousticModelImpl::render_stft_with_feature(const torch::Tensor& feature,
+                                                          const torch::Tensor& mic_norm,
+                                                          const torch::Tensor& src_norm,
+                                                          const torch::Tensor& rot) {
+  torch::NoGradGuard no_grad;
+  EvalScope eval(*this);
+  const int64_t n = options_.max_len;
+  const auto device = field_->parameters().front().device();
+  const auto t = torch::arange(n, torch::dtype(torch::kInt64).device(device));
+  const auto mic = pose_row(mic_norm, "mic").expand({n, 3});
+  const auto src = pose_row(src_norm, "source").expand({n, 3});
+  const auto r = pose_row(rot, "rot").expand({n, 3});
+  const auto out = forward_with_feature(feature, t, mic, src, r);  // [T, C, F]
+  return out.permute({1, 2, 0}).contiguous();                       // [C, F, T]
+}
+
+torch::Tensor AcousticModelImpl::render_stft(const torch::Tensor& grid,
+                                             const torch::Tensor& mic_norm,
+                                             const torch::Tensor& src_norm,
+                                             const torch::Tensor& rot) {
+  torch::NoGradGuard no_grad;
+  EvalScope eval(*this);
+  return render_stft_with_feature(scene_feature(grid), mic_norm, src_norm, rot);
+}
+
+}  // namespace neraf::acoustic

@@ -1,0 +1,85 @@
+#pragma once
+// The acoustic branch without its data: ResNet3D scene encoder + encoders + NAcF
+// (neraf-reference.md §1.1, §1.6). The voxel grid itself lives in GridSampler (owned by the trainer,
+// which also owns the radiance field that fills it); this module only reads it.
+//
+// Grid modes (the paper's ablations):
+//   kSampled  the 7×S³ grid → ResNet3D → scene feature (the reference, default)
+//   kZeros    an all-zero 7×S³ grid (all 7 channels) through the same ResNet3D: no scene
+//             information, same network
+//   kNone     no ResNet3D; NAcF takes the no-grid input order [mic, source, time, rot] (163)
+//
+// Presets (acoustic_preset): "paper" = grid 128³, ResNet3D-50/layer3 (1024 features), NAcF
+// 1187→5096→2048→1024→1024→512; "cpu" = grid 32³, small BasicBlock ResNet3D (256 features),
+// NAcF 5×512 (the paper's text), bf16 trunk matrix products.
+#include <cstdint>
+#include <string>
+
+#include <torch/nn/module.h>
+#include <torch/nn/pimpl.h>
+#include <torch/types.h>
+
+#include "neraf/acoustic/grid_sampler.h"
+#include "neraf/acoustic/nacf.h"
+#include "neraf/acoustic/resnet3d.h"
+
+namespace neraf::acoustic {
+
+enum class GridMode { kSampled, kZeros, kNone };
+GridMode parse_grid_mode(const std::string& name);  // "sampled" | "zeros" | "none"
+std::string to_string(GridMode mode);
+
+struct AcousticModelOptions {
+  GridSamplerOptions grid;
+  ResNet3dOptions resnet = resnet3d_cpu_options();
+  NacfOptions nacf = nacf_cpu_options(2, 257);  // grid_features is set from resnet by the model
+  GridMode grid_mode = GridMode::kSampled;
+  int64_t max_len = 78;  // frames per RIR (time normalisation t/(max_len − 1)); set from the data
+};
+
+// name: "cpu" | "paper"; n_channels C, n_freq F and max_len come from the dataset.
+AcousticModelOptions acoustic_preset(const std::string& name, int64_t n_channels, int64_t n_freq,
+                                     int64_t max_len);
+
+class AcousticModelImpl : public torch::nn::Module {
+ public:
+  explicit AcousticModelImpl(AcousticModelOptions options);
+
+  // Scene feature from the grid: [7, S, S, S] → [G] (kSampled), zeros grid → [G] (kZeros; `grid`
+  // may be undefined), undefined tensor (kNone). Runs ResNet3D in the module's current mode.
+  torch::Tensor scene_feature(const torch::Tensor& grid);
+
+  // grid: [7, S, S, S] (ignored for kZeros/kNone; may be undefined there); t: [B] int64 frame
+  // indices; mic_norm, src_norm: [B, 3] normalised positions; rot: [B, 3] stored orientation.
+  // → [B, C, F] predicted log-magnitudes. ResNet3D runs on every call (the reference re-runs it on
+  // every audio step; its gradient reaches the freshly written grid cells).
+  torch::Tensor forward(const torch::Tensor& grid, const torch::Tensor& t,
+                        const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
+                        const torch::Tensor& rot);
+  // Same with a precomputed scene feature ([G], or undefined for kNone).
+  torch::Tensor forward_with_feature(const torch::Tensor& feature, const torch::Tensor& t,
+                                     const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
+                                     const torch::Tensor& rot);
+
+  // All frames t = 0..max_len−1 of one pose (mic_norm, src_norm, rot: [3] or [1, 3]) → [C, F, T].
+  // No autograd, ResNet3D and NAcF in eval mode (the previous mode is restored), one batch of T.
+  torch::Tensor render_stft(const torch::Tensor& grid, const torch::Tensor& mic_norm,
+                            const torch::Tensor& src_norm, const torch::Tensor& rot);
+  // Same from a scene feature computed once (in eval mode) for many RIRs.
+  torch::Tensor render_stft_with_feature(const torch::Tensor& feature,
+                                         const torch::Tensor& mic_norm,
+                                         const torch::Tensor& src_norm, const torch::Tensor& rot);
+
+  const AcousticModelOptions& options() const { return options_; }
+  // Null for GridMode::kNone.
+  ResNet3d& resnet3d() { return resnet3d_; }
+  Nacf& field() { return field_; }
+
+ private:
+  AcousticModelOptions options_;
+  ResNet3d resnet3d_{nullptr};  // registered as "resnet3d"
+  Nacf field_{nullptr};         // registered as "field"
+};
+TORCH_MODULE(AcousticModel);
+
+}  // namespace neraf::acoustic

@@ -1,0 +1,37 @@
+#include "neraf/acoustic/losses.h"
+
+#include <torch/torch.h>
+
+namespace neraf::acoustic {
+
+AudioLossTerms sc_slmse_loss(const torch::Tensor& pred, const torch::Tensor& gt,
+                             const AudioLossOptions& options) {
+  TORCH_CHECK(pred.sizes() == gt.sizes(), "sc_slmse_loss: pred ", pred.sizes(), " vs gt ",
+              gt.sizes());
+  const auto p = pred.to(torch::kFloat32);
+  const auto g = gt.to(torch::kFloat32);
+  const auto x = torch::exp(p) - 1e-3;
+  const auto y = torch::exp(g) - 1e-3;
+  AudioLossTerms t;
+  t.sc = torch::norm(y - x) / torch::norm(y);  // Frobenius over the whole batch
+  t.sl = torch::mse_loss(p, g);
+  t.sc_loss = t.sc * (options.loss_factor * options.sc_weight);
+  t.mag_loss = t.sl * (options.loss_factor * options.mag_weight);
+  t.total = t.sc_loss + t.mag_loss;
+  return t;
+}
+
+torch::Tensor energy_decay_loss(const torch::Tensor& pred, const torch::Tensor& gt, double eps) {
+  TORCH_CHECK(pred.dim() == 4 && pred.sizes() == gt.sizes(),
+              "energy_decay_loss: expected equal [B, C, F, T] shapes, got ", pred.sizes(), " and ",
+              gt.sizes());
+  auto decay_db = [eps](const torch::Tensor& log_mag) {
+    const auto m = torch::clamp_min(torch::exp(log_mag.to(torch::kFloat32)) - 1e-3, 0.0);
+    const auto e = (m * m).sum(2);                               // [B, C, T]
+    const auto d = torch::flip(torch::cumsum(torch::flip(e, {2}), 2), {2});  // Σ_{τ≥t}
+    return torch::log10(d + eps);
+  };
+  return torch::abs(decay_db(pred) - decay_db(gt)).mean();
+}
+
+}  // namespace neraf::acoustic

@@ -1,0 +1,46 @@
+#pragma once
+// Audio losses (neraf-reference.md §2.2).
+//
+// "SC+SLMSE" on a batch of predicted / ground-truth log-magnitude frames [B, C, F]
+// (log(|STFT| + 1e-3)):
+//   X = exp(pred) − 1e-3,  Y = exp(gt) − 1e-3     (no clipping, as the reference)
+//   SC = ‖Y − X‖_F / ‖Y‖_F over the WHOLE batch tensor (one ratio, not a per-sample mean)
+//   SL = mean((gt − pred)²)
+//   audio_sc_loss = loss_factor·sc_weight·SC = 1e-3·0.1·SC,  audio_mag_loss = 1e-3·1.0·SL
+//
+// Energy-decay loss (optional, the paper's "++" variant; the published code only carries it as a
+// comment): on whole RIRs [B, C, F, T] (all T frames of each RIR, in order),
+//   M = clamp(exp(log_mag) − 1e-3, 0)           magnitudes
+//   E_t = Σ_f M[f, t]²                           frame energy
+//   D_t = Σ_{τ ≥ t} E_τ                          backward cumulative energy (Schroeder curve)
+//   decay = mean over (B, C, T) of |log10(D_t^pred + eps) − log10(D_t^gt + eps)|
+// eps (1e-12) keeps an all-zero tail finite. audio_decay_loss = loss_factor·decay_weight·decay.
+#include <torch/types.h>
+
+namespace neraf::acoustic {
+
+struct AudioLossOptions {
+  double loss_factor = 1e-3;
+  double sc_weight = 0.1;
+  double mag_weight = 1.0;
+  double decay_weight = 0.0;  // energy-decay term weight (0 = off, the reference)
+  double decay_eps = 1e-12;
+};
+
+struct AudioLossTerms {
+  torch::Tensor sc;        // [] raw spectral convergence ‖Y − X‖_F / ‖Y‖_F
+  torch::Tensor sl;        // [] raw mean squared log-magnitude error
+  torch::Tensor sc_loss;   // [] audio_sc_loss = loss_factor·sc_weight·sc
+  torch::Tensor mag_loss;  // [] audio_mag_loss = loss_factor·mag_weight·sl
+  torch::Tensor total;     // [] sc_loss + mag_loss (+ decay_loss when added by the caller)
+};
+
+// pred, gt: [B, C, F] (any equal shape) log-magnitudes.
+AudioLossTerms sc_slmse_loss(const torch::Tensor& pred, const torch::Tensor& gt,
+                             const AudioLossOptions& options = {});
+
+// pred, gt: [B, C, F, T] log-magnitudes of whole RIRs → [] raw energy-decay L1 (unweighted).
+torch::Tensor energy_decay_loss(const torch::Tensor& pred, const torch::Tensor& gt,
+                                double eps = 1e-12);
+
+}  // namespace neraf::acoustic

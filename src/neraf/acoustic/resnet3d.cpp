@@ -1,0 +1,123 @@
+#include "neraf/acoustic/resnet3d.h"
+
+#include <string>
+
+#include <torch/torch.h>
+
+#include "neraf/util/error.h"
+
+namespace neraf::acoustic {
+
+namespace nn = torch::nn;
+
+ResNet3dOptions resnet3d_paper_options() { return ResNet3dOptions{}; }
+
+ResNet3dOptions resnet3d_cpu_options() {
+  // Sized for a 7×32³ grid on 2 cores: stem 32 ch (k5, s2) → 16³, max pool → 8³, BasicBlocks
+  // 64 @ 8³, 128 @ 4³, 256 @ 2³ → 256 features (≈ 1.3 M parameters).
+  ResNet3dOptions o;
+  o.stem_channels = 32;
+  o.block = ResBlock::kBasic;
+  o.layers = {1, 1, 1};
+  o.planes = {64, 128, 256};
+  return o;
+}
+
+int64_t resnet3d_expansion(ResBlock block) { return block == ResBlock::kBottleneck ? 4 : 1; }
+
+int64_t resnet3d_out_features(const ResNet3dOptions& options) {
+  return options.planes.back() * resnet3d_expansion(options.block);
+}
+
+namespace {
+
+nn::Conv3d conv(int64_t in, int64_t out, int64_t kernel, int64_t stride, int64_t padding) {
+  return nn::Conv3d(
+      nn::Conv3dOptions(in, out, kernel).stride(stride).padding(padding).bias(false));
+}
+
+}  // namespace
+
+ResBlock3dImpl::ResBlock3dImpl(ResBlock kind, int64_t in_channels, int64_t planes, int64_t stride)
+    : kind_(kind) {
+  const int64_t out_channels = planes * resnet3d_expansion(kind);
+  if (kind == ResBlock::kBottleneck) {
+    conv1 = register_module("conv1", conv(in_channels, planes, 1, 1, 0));
+    bn1 = register_module("bn1", nn::BatchNorm3d(planes));
+    conv2 = register_module("conv2", conv(planes, planes, 3, stride, 1));
+    bn2 = register_module("bn2", nn::BatchNorm3d(planes));
+    conv3 = register_module("conv3", conv(planes, out_channels, 1, 1, 0));
+    bn3 = register_module("bn3", nn::BatchNorm3d(out_channels));
+  } else {
+    conv1 = register_module("conv1", conv(in_channels, planes, 3, stride, 1));
+    bn1 = register_module("bn1", nn::BatchNorm3d(planes));
+    conv2 = register_module("conv2", conv(planes, planes, 3, 1, 1));
+    bn2 = register_module("bn2", nn::BatchNorm3d(planes));
+  }
+  if (stride != 1 || in_channels != out_channels) {
+    downsample = register_module(
+        "downsample",
+        nn::Sequential(conv(in_channels, out_channels, 1, stride, 0), nn::BatchNorm3d(out_channels)));
+  }
+}
+
+torch::Tensor ResBlock3dImpl::forward(const torch::Tensor& x) {
+  auto h = torch::relu(bn1(conv1(x)));
+  if (kind_ == ResBlock::kBottleneck) {
+    h = torch::relu(bn2(conv2(h)));
+    h = bn3(conv3(h));
+  } else {
+    h = bn2(conv2(h));
+  }
+  const auto residual = downsample ? downsample->forward(x) : x;
+  return torch::relu(h + residual);
+}
+
+ResNet3dImpl::ResNet3dImpl(ResNet3dOptions options) : options_(std::move(options)) {
+  const auto& o = options_;
+  require(o.in_channels >= 1 && o.stem_channels >= 1 && o.stem_kernel >= 1,
+          "resnet3d: channels and stem kernel must be positive");
+  require(!o.layers.empty() && o.layers.size() == o.planes.size() &&
+              o.layers.size() == o.strides.size(),
+          "resnet3d: layers, planes and strides must be non-empty and of equal length");
+  conv1 = register_module("conv1", conv(o.in_channels, o.stem_channels, o.stem_kernel, 2,
+                                        o.stem_kernel / 2));
+  bn1 = register_module("bn1", nn::BatchNorm3d(o.stem_channels));
+  int64_t in = o.stem_channels;
+  for (size_t s = 0; s < o.layers.size(); ++s) {
+    require(o.layers[s] >= 1 && o.planes[s] >= 1 && o.strides[s] >= 1,
+            "resnet3d: blocks, planes and strides must be positive");
+    nn::Sequential stage;
+    for (int64_t b = 0; b < o.layers[s]; ++b) {
+      stage->push_back(ResBlock3d(o.block, in, o.planes[s], b == 0 ? o.strides[s] : 1));
+      in = o.planes[s] * resnet3d_expansion(o.block);
+    }
+    layers_.push_back(register_module("layer" + std::to_string(s + 1), stage));
+  }
+  // Reference init: xavier_normal_ for every conv, BN weight 1 / bias 0 (also LibTorch's default).
+  for (auto& m : modules(/*include_self=*/false)) {
+    if (auto* c = m->as<nn::Conv3d>()) {
+      nn::init::xavier_normal_(c->weight);
+    } else if (auto* bn = m->as<nn::BatchNorm3d>()) {
+      nn::init::ones_(bn->weight);
+      nn::init::zeros_(bn->bias);
+    }
+  }
+}
+
+torch::Tensor ResNet3dImpl::feature_map(const torch::Tensor& x) {
+  TORCH_CHECK(x.dim() == 5 && x.size(1) == options_.in_channels, "ResNet3d: expected [B, ",
+              options_.in_channels, ", S, S, S], got ", x.sizes());
+  auto h = torch::relu(bn1(conv1(x)));
+  if (options_.stem_max_pool) {
+    h = torch::max_pool3d(h, /*kernel_size=*/3, /*stride=*/2, /*padding=*/1);
+  }
+  for (auto& stage : layers_) h = stage->forward(h);
+  return h;
+}
+
+torch::Tensor ResNet3dImpl::forward(const torch::Tensor& x) {
+  return torch::adaptive_avg_pool3d(feature_map(x), 1).flatten(1);  // [B, C]
+}
+
+}  // namespace neraf::acoustic

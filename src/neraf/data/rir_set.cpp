@@ -1,0 +1,376 @@
+#include "neraf/data/rir_set.h"
+
+#include <ATen/Parallel.h>
+#include <omp.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <limits>
+#include <mutex>
+#include <sstream>
+
+#include "neraf/data/audio_probe.h"
+#include "neraf/data/feature_cache.h"
+#include "neraf/data/layout.h"
+#include "neraf/data/rir_layouts.h"
+#include "neraf/io/npy.h"
+#include "neraf/util/error.h"
+#include "neraf/util/log.h"
+
+namespace fs = std::filesystem;
+
+namespace neraf::data {
+
+const char* to_string(AudioLayout layout) {
+  return layout == AudioLayout::soundspaces ? "soundspaces" : "raf";
+}
+
+geometry::Vec3 normalize_position(const geometry::Vec3& p, const Aabb& box) {
+  geometry::Vec3 q;
+  for (int k = 0; k < 3; ++k) {
+    q[k] = (p[k] - box.min[k]) / (box.max[k] - box.min[k]);
+    if (!(q[k] > 0.0 && q[k] < 1.0)) return {0, 0, 0};
+  }
+  return q;
+}
+
+torch::Tensor normalize_position(const torch::Tensor& p, const Aabb& box) {
+  TORCH_CHECK(p.dim() == 2 && p.size(1) == 3, "normalize_position: positions must be [N, 3]");
+  const auto opts = torch::TensorOptions().dtype(p.scalar_type());
+  const torch::Tensor lo = torch::tensor({box.min.x, box.min.y, box.min.z}, torch::kFloat64).to(opts);
+  const torch::Tensor hi = torch::tensor({box.max.x, box.max.y, box.max.z}, torch::kFloat64).to(opts);
+  torch::Tensor q = (p - lo) / (hi - lo);
+  const torch::Tensor inside = ((q > 0) & (q < 1)).all(1, /*keepdim=*/true);
+  return q * inside.to(q.scalar_type());
+}
+
+std::array<double, 3> encode_heading(int heading_deg) {
+  const double a = heading_deg * 3.14159265358979323846 / 180.0;
+  return {(std::cos(a) + 1.0) / 2.0, 0.5, (std::sin(a) + 1.0) / 2.0};
+}
+
+// ---------------------------------------------------------------------------------------------
+namespace detail {
+
+FileStamp stamp(const std::string& path) {
+  struct stat st {};
+  FileStamp s;
+  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return s;
+  s.exists = true;
+  s.size = static_cast<int64_t>(st.st_size);
+  s.mtime_ns = static_cast<int64_t>(st.st_mtim.tv_sec) * 1000000000LL + st.st_mtim.tv_nsec;
+  return s;
+}
+
+void write_padded_log(const std::vector<const float*>& mags, int64_t n_freq, int64_t n_frames,
+                      int64_t max_len, float* out) {
+  const int64_t C = static_cast<int64_t>(mags.size());
+  float mn = std::numeric_limits<float>::infinity();
+  for (const float* m : mags)
+    for (int64_t k = 0; k < n_freq * n_frames; ++k) mn = std::min(mn, m[k]);
+  const float pad = std::log(mn + kLogEps);
+  const int64_t keep = std::min(n_frames, max_len);
+  for (int64_t t = 0; t < max_len; ++t)
+    for (int64_t c = 0; c < C; ++c) {
+      float* o = out + (t * C + c) * n_freq;
+      if (t < keep) {
+        const float* m = mags[c];
+        for (int64_t f = 0; f < n_freq; ++f) o[f] = std::log(m[f * n_frames + t] + kLogEps);
+      } else {
+        std::fill(o, o + n_freq, pad);
+      }
+    }
+}
+
+void parallel_for_each(int64_t n, const std::function<void(int64_t)>& fn) {
+  std::exception_ptr first;
+  std::mutex m;
+  std::atomic<bool> failed{false};
+#pragma omp parallel for schedule(dynamic, 16)
+  for (int64_t i = 0; i < n; ++i) {
+    if (failed.load(std::memory_order_relaxed)) continue;
+    try {
+      fn(i);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(m);
+      if (!first) first = std::current_exception();
+      failed = true;
+    }
+  }
+  if (first) std::rethrow_exception(first);
+}
+
+}  // namespace detail
+
+// ---------------------------------------------------------------------------------------------
+namespace {
+
+using detail::RirIndex;
+
+void finish_index(RirSet& set) {
+  const int64_t n = set.size();
+  set.mic_positions = torch::empty({n, 3}, torch::kFloat64);
+  set.source_positions = torch::empty({n, 3}, torch::kFloat64);
+  set.rots = torch::empty({n, 3}, torch::kFloat64);
+  auto m = set.mic_positions.accessor<double, 2>();
+  auto s = set.source_positions.accessor<double, 2>();
+  auto r = set.rots.accessor<double, 2>();
+  for (int64_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      m[i][k] = set.rirs[i].mic[k];
+      s[i][k] = set.rirs[i].source[k];
+      r[i][k] = set.rirs[i].rot[k];
+    }
+  // The model's audio scene box: train microphone positions ± 1 m (sources not included).
+  if (!set.train.empty()) {
+    geometry::Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+    for (const int64_t i : set.train)
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], set.rirs[i].mic[k]);
+        hi[k] = std::max(hi[k], set.rirs[i].mic[k]);
+      }
+    set.audio_aabb = {lo - geometry::Vec3{1, 1, 1}, hi + geometry::Vec3{1, 1, 1}};
+  }
+}
+
+RirIndex make_index(const std::string& dir, AudioLayout layout, bool use_npy,
+                    ProblemList& problems) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
+    problems.error(dir, "is not a folder", "pass the dataset's scene/room folder");
+    RirIndex idx;
+    idx.set.layout = layout;
+    idx.set.root = dir;
+    return idx;
+  }
+  RirIndex idx = layout == AudioLayout::soundspaces
+                     ? detail::index_soundspaces(dir, use_npy, problems)
+                     : detail::index_raf(dir, problems);
+  finish_index(idx.set);
+  return idx;
+}
+
+bool writable_dir(const std::string& d) {
+  std::error_code ec;
+  fs::create_directories(d, ec);
+  return !ec && fs::is_directory(d, ec) && ::access(d.c_str(), W_OK) == 0;
+}
+
+std::string sanitize(std::string s) {
+  for (char& c : s)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  return s.empty() ? "dataset" : s;
+}
+
+void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& options) {
+  const bool ss = set.layout == AudioLayout::soundspaces;
+  const bool npy = ss && idx.use_npy;
+  const int64_t n = set.size();
+
+  // What the features depend on: recipe, parameters, and each source file's identity.
+  std::ostringstream params;
+  params << "neraf-features v1\nlayout " << to_string(set.layout) << "\nsource "
+         << (npy ? "npy-magnitudes" : "wav") << "\nmax_len "
+         << (options.max_len > 0 ? std::to_string(options.max_len) : "auto") << "\nstft "
+         << set.stft.n_fft << " " << set.stft.win_length << " " << set.stft.hop_length
+         << (set.stft.center ? " center" : "") << "\nsample_rate " << set.sample_rate
+         << "\nlog_eps 1e-3\ndtype " << (options.half_precision ? "float16" : "float32")
+         << "\nn_rirs " << n << "\n";
+  std::ostringstream files;
+  for (int64_t i = 0; i < n; ++i) {
+    const Rir& r = set.rirs[i];
+    const std::string& path = npy ? r.magnitude_path : r.wav_path;
+    const detail::FileStamp& st = npy ? idx.npy[i] : idx.wav[i];
+    files << r.id << '\t' << fs::path(path).lexically_relative(set.root).string() << '\t'
+          << st.size << '\t' << st.mtime_ns << '\n';
+  }
+  FeatureCacheSpec spec;
+  spec.key = hash_hex(params.str() + files.str());
+  spec.layout = to_string(set.layout);
+  spec.description = params.str() + "files: hashed (path, size, mtime of each)";
+  spec.n_rirs = n;
+  spec.channels = set.channels;
+  spec.n_freq = set.n_freq;
+  spec.max_len = options.max_len > 0 ? options.max_len : (ss ? 0 : detail::kRafMaxLen);
+  spec.half = options.half_precision;
+
+  // Where: the user's folder, else <root>/.neraf_cache, else the user cache folder.
+  std::string dir = options.cache_dir;
+  if (dir.empty()) {
+    dir = (fs::path(set.root) / ".neraf_cache").string();
+    if (!writable_dir(dir)) {
+      const char* xdg = std::getenv("XDG_CACHE_HOME");
+      const char* home = std::getenv("HOME");
+      const std::string fallback =
+          xdg && *xdg ? std::string(xdg) + "/neraf" : std::string(home ? home : "/tmp") + "/.cache/neraf";
+      warn(set.root + ": the dataset folder is not writable; caching audio features in " +
+           fallback + " (pass --cache-dir to choose)");
+      dir = fallback;
+    }
+  }
+  require(writable_dir(dir), dir + ": cannot create or write the feature cache folder; pass a "
+                                   "writable --cache-dir");
+  const std::string prefix =
+      sanitize(fs::path(set.root).lexically_normal().filename().string().empty()
+                   ? fs::absolute(set.root).parent_path().filename().string()
+                   : fs::path(set.root).lexically_normal().filename().string()) +
+      "_" + spec.layout + "_";
+  const std::string path = (fs::path(dir) / (prefix + spec.key + ".bin")).string();
+
+  std::shared_ptr<FeatureCache> cache = FeatureCache::open(path, spec);
+  if (!cache) {
+    if (spec.max_len == 0) {
+      // SoundSpaces automatic max_len: the longest STFT over all RIRs, from the headers only.
+      std::vector<int64_t> frames(n, 0);
+      detail::parallel_for_each(n, [&](int64_t i) {
+        if (npy) {
+          const io::NpyHeader h = io::read_npy_header(set.rirs[i].magnitude_path);
+          require(h.shape.size() == 3, set.rirs[i].magnitude_path +
+                                           ": expected magnitudes of shape [2, 257, T]; re-create it");
+          frames[i] = h.shape[2];
+        } else {
+          const AudioProbe p = probe_audio(set.rirs[i].wav_path);
+          require(p.ok, set.rirs[i].wav_path + ": " + p.error + "; restore the file");
+          frames[i] = detail::soundspaces_num_frames(p.frames);
+        }
+      });
+      spec.max_len = std::max<int64_t>(1, *std::max_element(frames.begin(), frames.end()));
+    }
+    const int64_t max_len = spec.max_len;
+    const double gb = double(n) * max_len * set.channels * set.n_freq * (spec.half ? 2 : 4) / 1e9;
+    char msg[160];
+    std::snprintf(msg, sizeof msg, "%s: building the audio feature cache (%lld RIRs x %lld frames, %.2f GB)",
+                  set.root.c_str(), static_cast<long long>(n), static_cast<long long>(max_len), gb);
+    if (options.progress) info(msg);
+    std::function<int64_t(int64_t, float*)> compute;
+    if (!ss)
+      compute = [&](int64_t i, float* out) {
+        return detail::raf_features(set.rirs[i].wav_path, max_len, out);
+      };
+    else if (npy)
+      compute = [&](int64_t i, float* out) {
+        return detail::soundspaces_features_from_npy(set.rirs[i].magnitude_path, max_len, out);
+      };
+    else
+      compute = [&](int64_t i, float* out) {
+        const int64_t t = detail::soundspaces_features_from_wav(set.rirs[i].wav_path, max_len, out);
+        return t;
+      };
+    cache = FeatureCache::build(path, spec, compute, options.progress);
+    // Drop caches of this dataset made for older files or other parameters (they can be huge).
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+      const std::string name = e.path().filename().string();
+      if (e.path().string() != path && name.rfind(prefix, 0) == 0 && e.path().extension() == ".bin") {
+        fs::remove(e.path(), ec);
+        if (!ec && options.progress) info("removed the stale feature cache " + e.path().string());
+      }
+    }
+  }
+  set.max_len = cache->spec().max_len;
+  set.cache_path = path;
+  set.waveform_length = ss ? set.max_len * set.stft.hop_length : detail::kRafSamples;
+  for (int64_t i = 0; i < n; ++i) set.rirs[i].num_frames = cache->own_length(i);
+  set.cache_ = cache;
+}
+
+RirSet load(const std::string& dir, AudioLayout layout, const RirLoadOptions& options) {
+  ProblemList problems;
+  RirIndex idx = make_index(dir, layout, options.use_magnitude_files, problems);
+  problems.throw_if_errors(dir);
+  if (options.progress) problems.print_warnings();
+  RirSet set = std::move(idx.set);
+  if (set.layout == AudioLayout::raf) {
+    set.max_len = options.max_len > 0 ? options.max_len : detail::kRafMaxLen;
+    set.waveform_length = detail::kRafSamples;
+  } else if (options.max_len > 0) {
+    set.max_len = options.max_len;
+    set.waveform_length = set.max_len * set.stft.hop_length;
+  }
+  if (options.load_features) attach_features(set, idx, options);
+  return set;
+}
+
+}  // namespace
+
+RirSet index_rir_set(const std::string& dir, AudioLayout layout, ProblemList& problems) {
+  return make_index(dir, layout, /*use_npy=*/true, problems).set;
+}
+
+RirSet load_soundspaces(const std::string& dir, const RirLoadOptions& options) {
+  return load(dir, AudioLayout::soundspaces, options);
+}
+
+RirSet load_raf(const std::string& dir, const RirLoadOptions& options) {
+  return load(dir, AudioLayout::raf, options);
+}
+
+RirSet load_rir_set(const std::string& dir, const RirLoadOptions& options) {
+  const DatasetLayout d = detect_layout(dir);
+  if (d.soundspaces) return load_soundspaces(dir, options);
+  if (d.raf) return load_raf(dir, options);
+  throw Error(dir + ": no impulse responses found (neither SoundSpaces binaural_rirs/ + "
+                    "metadata/points.txt nor RAF data/ + metadata/data-split.json); check the path");
+}
+
+// ---------------------------------------------------------------------------------------------
+
+torch::Tensor RirSet::features(int64_t i) const {
+  require(cache_ != nullptr, "RirSet: features were not loaded (RirLoadOptions::load_features)");
+  TORCH_CHECK(i >= 0 && i < size(), "RirSet::features: index ", i, " out of range [0, ", size(), ")");
+  torch::Tensor tcf = torch::empty({max_len, channels, n_freq}, torch::kFloat32);
+  cache_->read_frames(i, 0, max_len, tcf.data_ptr<float>());
+  return tcf.permute({1, 2, 0}).contiguous();  // [C, F, T]
+}
+
+void RirSet::gather_into(const torch::Tensor& rir, const torch::Tensor& frame,
+                         torch::Tensor& out) const {
+  require(cache_ != nullptr, "RirSet: features were not loaded (RirLoadOptions::load_features)");
+  TORCH_CHECK(rir.dim() == 1 && frame.dim() == 1 && rir.size(0) == frame.size(0),
+              "RirSet::gather: rir and frame must be [B] tensors of the same length");
+  const int64_t b = rir.size(0);
+  TORCH_CHECK(out.scalar_type() == torch::kFloat32 && out.is_contiguous() && out.dim() == 3 &&
+                  out.size(0) == b && out.size(1) == channels && out.size(2) == n_freq,
+              "RirSet::gather_into: out must be a contiguous float32 [B, C, F] tensor");
+  const torch::Tensor r = rir.to(torch::kInt64).contiguous();
+  const torch::Tensor f = frame.to(torch::kInt64).contiguous();
+  const int64_t* rp = r.data_ptr<int64_t>();
+  const int64_t* fp = f.data_ptr<int64_t>();
+  const int64_t n = size(), t = max_len;
+  for (int64_t k = 0; k < b; ++k)
+    TORCH_CHECK(rp[k] >= 0 && rp[k] < n && fp[k] >= 0 && fp[k] < t, "RirSet::gather: slice ", k,
+                " (rir ", rp[k], ", frame ", fp[k], ") out of range [", n, ", ", t, ")");
+  float* o = out.data_ptr<float>();
+  const int64_t slice = channels * n_freq;
+  const FeatureCache* c = cache_.get();
+  at::parallel_for(0, b, 256, [&](int64_t b0, int64_t b1) {
+    for (int64_t k = b0; k < b1; ++k) c->read_frames(rp[k], fp[k], 1, o + k * slice);
+  });
+}
+
+torch::Tensor RirSet::gather(const torch::Tensor& rir, const torch::Tensor& frame) const {
+  torch::Tensor out = torch::empty({rir.size(0), channels, n_freq}, torch::kFloat32);
+  gather_into(rir, frame, out);
+  return out;
+}
+
+torch::Tensor RirSet::waveform(int64_t i) const {
+  TORCH_CHECK(i >= 0 && i < size(), "RirSet::waveform: index ", i, " out of range");
+  require(waveform_length > 0, "RirSet: max_len is unknown until features are loaded (or "
+                               "RirLoadOptions::max_len is given)");
+  const auto chans = layout == AudioLayout::soundspaces
+                         ? detail::soundspaces_waveform(rirs[i].wav_path, waveform_length)
+                         : detail::raf_waveform(rirs[i].wav_path, waveform_length);
+  torch::Tensor w = torch::empty({static_cast<int64_t>(chans.size()), waveform_length}, torch::kFloat32);
+  for (size_t c = 0; c < chans.size(); ++c)
+    std::copy(chans[c].begin(), chans[c].end(), w[c].data_ptr<float>());
+  return w;
+}
+
+}  // namespace neraf::data

@@ -1,0 +1,297 @@
+#include "neraf/data/validate.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "neraf/data/audio_probe.h"
+#include "neraf/data/image_set.h"
+#include "neraf/data/rir_layouts.h"
+#include "neraf/io/npy.h"
+#include "neraf/util/error.h"
+#include "neraf/util/progress.h"
+
+namespace fs = std::filesystem;
+
+namespace neraf::data {
+
+Stats compute_stats(std::vector<double> v) {
+  v.erase(std::remove_if(v.begin(), v.end(), [](double x) { return std::isnan(x); }), v.end());
+  Stats s;
+  s.count = static_cast<int64_t>(v.size());
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  s.min = v.front();
+  s.max = v.back();
+  double sum = 0;
+  for (const double x : v) sum += x;
+  s.mean = sum / v.size();
+  const size_t m = v.size() / 2;
+  s.median = v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+  return s;
+}
+
+int64_t DatasetReport::num_errors() const {
+  return std::count_if(problems.begin(), problems.end(), [](const Problem& p) { return p.is_error(); });
+}
+int64_t DatasetReport::num_warnings() const {
+  return static_cast<int64_t>(problems.size()) - num_errors();
+}
+
+namespace {
+
+Aabb box_of(const std::vector<geometry::Vec3>& pts) {
+  Aabb b;
+  if (pts.empty()) return b;
+  b.min = b.max = pts[0];
+  for (const auto& p : pts)
+    for (int k = 0; k < 3; ++k) {
+      b.min[k] = std::min(b.min[k], p[k]);
+      b.max[k] = std::max(b.max[k], p[k]);
+    }
+  return b;
+}
+
+bool zeroed(const geometry::Vec3& p, const Aabb& box) {
+  const geometry::Vec3 q = normalize_position(p, box);
+  return q.x == 0 && q.y == 0 && q.z == 0;
+}
+
+// Per-RIR header check result (filled in parallel, reported in order).
+struct AudioCheck {
+  AudioProbe probe;
+  std::string npy_error;  // SoundSpaces magnitude file problem
+};
+
+void inspect_audio(DatasetReport& r, AudioLayout layout, const InspectOptions& options,
+                   ProblemList& problems) {
+  r.audio_layout = layout;
+  ProblemList index_problems;
+  const RirSet set = index_rir_set(r.dir, layout, index_problems);
+  problems.append(index_problems.items());
+  r.rirs_train = static_cast<int64_t>(set.train.size());
+  r.rirs_test = static_cast<int64_t>(set.test.size());
+  const bool ss = layout == AudioLayout::soundspaces;
+  r.expected_sample_rate = ss ? detail::kSoundSpacesWavRate : detail::kRafRate;
+  r.expected_channels = ss ? 2 : 1;
+  const int64_t n = set.size();
+  if (n == 0) return;
+
+  std::vector<AudioCheck> checks(static_cast<size_t>(n));
+  {
+    ProgressOptions popt;
+    popt.unit = "file";
+    popt.enabled = options.progress && n >= 2000;
+    Progress bar("checking audio headers", n, popt);
+    std::atomic<int64_t> done{0};
+    detail::parallel_for_each(n, [&](int64_t i) {
+      const Rir& rir = set.rirs[i];
+      checks[i].probe = probe_audio(rir.wav_path);
+      if (!rir.magnitude_path.empty()) {
+        try {
+          const io::NpyHeader h = io::read_npy_header(rir.magnitude_path);
+          if (h.shape.size() != 3 || h.shape[0] != 2 || h.shape[1] != set.n_freq || h.shape[2] < 1)
+            checks[i].npy_error = "magnitudes must have shape [2, 257, T]";
+        } catch (const Error& e) {
+          checks[i].npy_error = e.what();
+        }
+      }
+      const int64_t d = ++done;
+      if (omp_get_thread_num() == 0) bar.update(d);
+    });
+    bar.finish();
+  }
+
+  std::vector<double> durations;
+  for (int64_t i = 0; i < n; ++i) {
+    const Rir& rir = set.rirs[i];
+    const AudioProbe& p = checks[i].probe;
+    if (!rir.magnitude_path.empty()) ++r.magnitude_files;
+    if (!checks[i].npy_error.empty())
+      problems.error(rir.magnitude_path, checks[i].npy_error,
+                     "re-create it, or delete binaural_magnitudes_sr22050/ to use the wavs");
+    if (!p.ok) {
+      problems.error(rir.wav_path, p.error, "restore the file from the dataset release");
+      continue;
+    }
+    if (p.sample_rate != r.expected_sample_rate)
+      problems.error(rir.wav_path,
+                     "sample rate " + std::to_string(p.sample_rate) + " Hz, expected " +
+                         std::to_string(r.expected_sample_rate) + " Hz",
+                     std::string("resample it to ") + (ss ? "44.1" : "48") + " kHz");
+    if (p.channels != r.expected_channels)
+      problems.error(rir.wav_path,
+                     std::to_string(p.channels) + " channel(s), expected " +
+                         std::to_string(r.expected_channels) + (ss ? " (binaural)" : " (mono)"),
+                     ss ? "SoundSpaces RIRs must be 2-channel binaural files"
+                        : "RAF RIRs must be mono; keep one channel");
+    if (p.frames == 0)
+      problems.warning(rir.wav_path, "holds no samples (treated as silence, like the reference)",
+                       "restore the file if it should not be empty");
+    else if (!ss && p.frames < detail::kRafSamples)
+      problems.warning(rir.wav_path,
+                       "shorter than 0.32 s (" + std::to_string(p.frames) + " samples)",
+                       "it is zero-padded to 15360 samples");
+    durations.push_back(p.duration_s());
+  }
+  r.duration_s = compute_stats(durations);
+
+  std::vector<geometry::Vec3> mics, sources;
+  for (const Rir& rir : set.rirs) {
+    mics.push_back(rir.mic);
+    sources.push_back(rir.source);
+  }
+  r.mic_box = box_of(mics);
+  r.source_box = box_of(sources);
+  r.audio_aabb = set.audio_aabb;
+  if (!set.train.empty()) {
+    for (const int64_t i : set.test) r.test_mics_outside += zeroed(set.rirs[i].mic, set.audio_aabb);
+    for (const Rir& rir : set.rirs) r.sources_outside += zeroed(rir.source, set.audio_aabb);
+  }
+
+  if (!options.t60) return;
+  // T60 on at most max_sample_reads RIRs, evenly spaced (deterministic), readable ones only.
+  std::vector<int64_t> readable;
+  for (int64_t i = 0; i < n; ++i)
+    if (checks[i].probe.ok && checks[i].probe.frames > 0 &&
+        checks[i].probe.sample_rate == r.expected_sample_rate)
+      readable.push_back(i);
+  const int64_t m = std::min<int64_t>(static_cast<int64_t>(readable.size()),
+                                      std::max<int64_t>(options.max_sample_reads, 1));
+  r.t60_subsampled = m < n;
+  std::vector<int64_t> pick(static_cast<size_t>(m));
+  for (int64_t k = 0; k < m; ++k) pick[k] = readable[k * static_cast<int64_t>(readable.size()) / m];
+  std::vector<std::vector<double>> t60(static_cast<size_t>(m));
+  ProgressOptions popt;
+  popt.unit = "RIR";
+  popt.enabled = options.progress && m >= 200;
+  Progress bar("measuring T60", m, popt);
+  std::atomic<int64_t> done{0};
+  detail::parallel_for_each(m, [&](int64_t k) {
+    try {
+      t60[k] = options.t60(io::read_audio(set.rirs[pick[k]].wav_path), layout);
+    } catch (const Error&) {
+      t60[k] = {std::nan("")};  // unreadable samples: counted as invalid
+    }
+    const int64_t d = ++done;
+    if (omp_get_thread_num() == 0) bar.update(d);
+  });
+  bar.finish();
+  std::vector<double> all;
+  for (const auto& v : t60)
+    for (const double x : v) {
+      if (std::isnan(x))
+        ++r.t60_invalid;
+      else
+        all.push_back(x);
+    }
+  r.t60_s = compute_stats(all);
+  r.t60_rirs = m;
+}
+
+std::string fmt_stats(const Stats& s, const char* unit, int prec = 3) {
+  if (s.count == 0) return "n/a";
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "min %.*f  mean %.*f  median %.*f  max %.*f %s", prec, s.min, prec,
+                s.mean, prec, s.median, prec, s.max, unit);
+  return buf;
+}
+
+std::string fmt_box(const Aabb& b) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "[%.3f, %.3f, %.3f] .. [%.3f, %.3f, %.3f] m", b.min.x, b.min.y,
+                b.min.z, b.max.x, b.max.y, b.max.z);
+  return buf;
+}
+
+}  // namespace
+
+DatasetReport inspect_dataset(const std::string& dir, const InspectOptions& options) {
+  DatasetReport r;
+  r.dir = dir;
+  ProblemList problems;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) {
+    problems.error(dir, "is not a folder", "pass the dataset's scene/room folder");
+    r.problems = problems.items();
+    return r;
+  }
+  r.layout = detect_layout(dir);
+  if (r.layout.empty())
+    problems.error(dir, "holds no known dataset layout",
+                   "expected SoundSpaces (binaural_rirs/, metadata/points.txt), RAF (data/, "
+                   "metadata/data-split.json) and/or nerfstudio images (transforms.json)");
+  if (r.layout.soundspaces && r.layout.raf)
+    problems.warning(dir, "looks like both a SoundSpaces and a RAF scene; SoundSpaces is used",
+                     "keep one layout per folder");
+  if (r.layout.has_audio())
+    inspect_audio(r, r.layout.soundspaces ? AudioLayout::soundspaces : AudioLayout::raf, options,
+                  problems);
+  if (r.layout.nerfstudio && options.check_images) {
+    ImageLoadOptions iopt;
+    iopt.progress = false;
+    const ImageSet images = check_transforms_json(dir, iopt, problems);
+    r.images_train = images.train.size();
+    r.images_eval = images.eval.size();
+    r.image_eval_mode = images.eval_mode;
+    const ImageSplit& s = images.train.size() ? images.train : images.eval;
+    if (s.size()) {
+      r.image_width = s.intrinsics[0].width;
+      r.image_height = s.intrinsics[0].height;
+    }
+  }
+  r.problems = problems.items();
+  return r;
+}
+
+std::vector<Problem> validate_dataset(const std::string& dir) {
+  InspectOptions o;
+  o.progress = false;
+  return inspect_dataset(dir, o).problems;
+}
+
+std::string format_report(const DatasetReport& r) {
+  std::ostringstream o;
+  o << "dataset      " << r.dir << "\n";
+  o << "layout       " << r.layout.describe() << "\n";
+  if (r.layout.has_audio()) {
+    const bool ss = r.audio_layout == AudioLayout::soundspaces;
+    o << "RIRs         " << r.rirs_train << " train, " << r.rirs_test << " test ("
+      << (ss ? "binaural, 44.1 kHz files; features at 22.05 kHz" : "mono, 48 kHz") << ")\n";
+    if (ss)
+      o << "magnitudes   " << r.magnitude_files << " published .npy files"
+        << (r.magnitude_files == r.rirs_train + r.rirs_test && r.magnitude_files > 0
+                ? " (used for features)"
+                : " (features computed from the wavs)")
+        << "\n";
+    o << "duration     " << fmt_stats(r.duration_s, "s") << "\n";
+    o << "mic box      " << fmt_box(r.mic_box) << "\n";
+    o << "source box   " << fmt_box(r.source_box) << "\n";
+    o << "audio aabb   " << fmt_box(r.audio_aabb) << " (train mics ± 1 m)\n";
+    if (r.test_mics_outside || r.sources_outside)
+      o << "             outside it (normalised to 0, as the reference does): "
+        << r.test_mics_outside << " test mics, " << r.sources_outside << " sources\n";
+    if (r.t60_rirs > 0) {
+      o << "T60          " << fmt_stats(r.t60_s, "s")
+        << (ss ? "  (full band, 30 dB decay)" : "  (200 Hz high-pass, 10 dB decay)") << "\n";
+      o << "             over " << r.t60_rirs << " RIRs"
+        << (r.t60_subsampled ? " (an evenly spaced subset)" : "") << ", " << r.t60_invalid
+        << " channel(s) without a value\n";
+    }
+  }
+  if (r.layout.nerfstudio) {
+    o << "images       " << r.images_train << " train, " << r.images_eval << " eval";
+    if (r.image_width > 0) o << ", " << r.image_width << "x" << r.image_height;
+    if (!r.image_eval_mode.empty()) o << " (split: " << r.image_eval_mode << ")";
+    o << "\n";
+  }
+  o << "problems     " << r.num_errors() << " error(s), " << r.num_warnings() << " warning(s)\n";
+  return o.str();
+}
+
+}  // namespace neraf::data

@@ -1,0 +1,143 @@
+#include "neraf/render/view.h"
+
+#include <torch/torch.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "neraf/io/json_file.h"
+#include "neraf/nerf/render_image.h"
+#include "neraf/train/image_output.h"
+#include "neraf/util/error.h"
+
+namespace neraf::render {
+
+torch::Tensor depth_colormap(const torch::Tensor& t) {
+  // Control points of the ramp (evenly spaced in t): dark blue, blue, cyan, green, yellow,
+  // orange, dark red.
+  static const float kStops[7][3] = {{0.19f, 0.07f, 0.23f}, {0.16f, 0.45f, 0.95f},
+                                     {0.10f, 0.85f, 0.80f}, {0.40f, 0.95f, 0.30f},
+                                     {0.95f, 0.85f, 0.20f}, {0.95f, 0.45f, 0.10f},
+                                     {0.50f, 0.02f, 0.01f}};
+  const torch::Tensor stops = torch::from_blob(const_cast<float*>(&kStops[0][0]), {7, 3},
+                                               torch::kFloat32)
+                                  .to(t.device());
+  const torch::Tensor x = t.to(torch::kFloat32).clamp(0.0, 1.0) * 6.0;
+  const torch::Tensor lo = x.floor().clamp(0, 5).to(torch::kInt64);
+  const torch::Tensor f = (x - lo.to(torch::kFloat32)).unsqueeze(-1);
+  const auto shape = lo.sizes().vec();
+  const torch::Tensor a = stops.index_select(0, lo.reshape({-1})).view({-1, 3});
+  const torch::Tensor b = stops.index_select(0, (lo + 1).reshape({-1})).view({-1, 3});
+  std::vector<int64_t> out_shape = shape;
+  out_shape.push_back(3);
+  return (a.view(out_shape) * (1.0 - f) + b.view(out_shape) * f);
+}
+
+torch::Tensor colorize_depth(const torch::Tensor& depth, double near, double far) {
+  const torch::Tensor d = depth.to(torch::kFloat32);
+  if (!(near < far)) {
+    const torch::Tensor flat = d.reshape({-1});
+    near = torch::quantile(flat, 0.01).item<double>();
+    far = torch::quantile(flat, 0.99).item<double>();
+    if (!(far > near)) far = near + 1e-6;
+  }
+  return depth_colormap((d - near) / (far - near));
+}
+
+torch::Tensor normalize_pose(const torch::Tensor& c2w, const torch::Tensor& world_transform,
+                             double world_scale) {
+  const torch::Tensor m = c2w.to(torch::kFloat64);
+  const torch::Tensor R = world_transform.to(torch::kFloat64).slice(1, 0, 3);
+  const torch::Tensor t = world_transform.to(torch::kFloat64).select(1, 3);
+  const torch::Tensor rot = torch::matmul(R, m.slice(1, 0, 3));
+  const torch::Tensor pos = (torch::matmul(R, m.select(1, 3)) + t) * world_scale;
+  return torch::cat({rot, pos.unsqueeze(1)}, 1).to(torch::kFloat32);
+}
+
+namespace {
+
+torch::Tensor matrix_from_json(const nlohmann::json& j, const std::string& where) {
+  require(j.is_array() && (j.size() == 3 || j.size() == 4),
+          where + ": expected a 4×4 or 3×4 matrix (array of rows)");
+  std::vector<double> v;
+  for (const auto& row : j) {
+    require(row.is_array() && row.size() == 4, where + ": every row needs 4 numbers");
+    for (const auto& x : row) {
+      require(x.is_number(), where + ": matrix entries must be numbers");
+      v.push_back(x.get<double>());
+      require(std::isfinite(v.back()), where + ": matrix entries must be finite");
+    }
+  }
+  torch::Tensor m = torch::tensor(v, torch::kFloat64).view({static_cast<int64_t>(j.size()), 4});
+  if (j.size() == 4) {
+    const auto last = m[3];
+    require(torch::allclose(last, torch::tensor({0.0, 0.0, 0.0, 1.0}, torch::kFloat64), 1e-6,
+                            1e-6),
+            where + ": the last row of a 4×4 pose must be 0 0 0 1");
+    m = m.slice(0, 0, 3);
+  }
+  const torch::Tensor R = m.slice(1, 0, 3);
+  const double ortho =
+      (torch::matmul(R, R.t()) - torch::eye(3, torch::kFloat64)).abs().max().item<double>();
+  require(ortho < 1e-3, where + ": the rotation part is not orthonormal (a camera-to-world "
+                                "matrix is [R | t] with R a rotation)");
+  return m;
+}
+
+}  // namespace
+
+Camera read_camera_file(const std::string& path, const nlohmann::json& manifest) {
+  const nlohmann::json j = io::read_json(path);
+  nlohmann::json m;
+  if (j.is_array()) {
+    m = j;
+  } else {
+    require(j.is_object(), path + ": expected an object with \"camera_to_world\" or a matrix");
+    if (j.contains("camera_to_world"))
+      m = j["camera_to_world"];
+    else if (j.contains("transform_matrix"))
+      m = j["transform_matrix"];
+    else
+      throw Error(path + ": missing \"camera_to_world\" (a 4×4 or 3×4 camera-to-world matrix)");
+  }
+  const torch::Tensor c2w = matrix_from_json(m, path + ": camera_to_world");
+  Camera cam;
+  std::vector<double> wt;
+  for (const auto& row : manifest.at("world_transform"))
+    for (const auto& x : row) wt.push_back(x.get<double>());
+  cam.c2w = normalize_pose(c2w, torch::tensor(wt, torch::kFloat64).view({3, 4}),
+                           manifest.at("world_scale").get<double>());
+  cam.intrinsics = train::manifest_intrinsics(manifest, -1);
+  if (j.is_object() && j.contains("intrinsics")) {
+    nlohmann::json k = j["intrinsics"];
+    require(k.is_object(), path + ": \"intrinsics\" must be an object");
+    // Accept transforms.json spellings.
+    for (auto [from, to] : {std::pair<const char*, const char*>{"fl_x", "fx"}, {"fl_y", "fy"},
+                            {"w", "width"}, {"h", "height"}})
+      if (k.contains(from) && !k.contains(to)) k[to] = k[from];
+    // Missing fields keep the default camera's values (the principal point is not rescaled when
+    // only the size changes: give cx, cy with a new width/height).
+    nlohmann::json merged = {{"fx", cam.intrinsics.fx},       {"fy", cam.intrinsics.fy},
+                             {"cx", cam.intrinsics.cx},       {"cy", cam.intrinsics.cy},
+                             {"width", cam.intrinsics.width}, {"height", cam.intrinsics.height}};
+    for (auto it = k.begin(); it != k.end(); ++it) merged[it.key()] = it.value();
+    cam.intrinsics = train::intrinsics_from_json(merged, path + ": intrinsics");
+  }
+  return cam;
+}
+
+ViewOutputs render_view(train::LoadedRun& run, const Camera& camera, const std::string& png,
+                        const std::string& depth_png, int64_t chunk) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const nerf::RenderedImage img =
+      nerf::render_image(run.model, camera.c2w, camera.intrinsics, chunk);
+  ViewOutputs out;
+  out.rgb = img.rgb.cpu();
+  out.depth = img.depth.cpu();
+  train::write_png(png, out.rgb);
+  if (!depth_png.empty()) train::write_png(depth_png, colorize_depth(out.depth));
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+}  // namespace neraf::render

@@ -1,0 +1,21 @@
+#pragma once
+// Built-in scenes (`neraf synth --preset NAME`). Each is an ordinary Scene value: what
+// `scene_to_json(preset_scene(name))` prints can be edited and passed back with --scene.
+//   demo       4 × 2.7 × 3.5 m, 3 textured boxes, 29 grid points × 4 headings × 2 sources = 232
+//              binaural RIRs (0.6 s), 50 + 10 photos at 96 × 96 — trains in minutes on 2 cores.
+//   shoebox    5 × 3 × 4 m empty room, one uniform material (for Sabine/Eyring checks), 20 × 4 × 1
+//              = 80 RIRs (1 s), 30 + 10 photos at 96 × 96.
+//   furnished  7 × 3 × 6 m, 7 boxes, 0.5 m grid (~130 points) × 4 × 2 sources ≈ 1,050 RIRs
+//              (0.8 s), 100 + 20 photos at 128 × 128.
+#include <string>
+#include <vector>
+
+#include "neraf/sim/scene.h"
+
+namespace neraf::sim {
+
+std::vector<std::string> preset_names();
+// Throws neraf::Error naming the known presets for an unknown name.
+Scene preset_scene(const std::string& name);
+
+}  // namespace neraf::sim

@@ -1,0 +1,71 @@
+#pragma once
+// `neraf synth`: a whole dataset from one scene — photos (image_renderer), RIRs (RirSimulator) and
+// the files of the chosen layout (layout_writers), in one output folder:
+//
+//   soundspaces (NeRAF's SoundSpaces layout, binaural 44.1 kHz)   raf (RAF layout, mono 48 kHz)
+//     scene.json, synth_info.json                                  scene.json, synth_info.json
+//     transforms.json + images/{train,eval}_frame_XXXXX.png        transforms.json + images/frame_XXXXX.png
+//     metadata/points.txt                                          data/<6-digit id>/rir.wav
+//     metadata_AudioNeRF/split.json                                data/<id>/rx_pos.txt, tx_pos.txt
+//     binaural_rirs/<heading>/<r>_<s>.wav                          metadata/data-split.json
+//
+// Deterministic: the same scene + seed give byte-identical files for any thread count.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "neraf/sim/cameras.h"
+#include "neraf/sim/scene.h"
+
+namespace neraf::sim {
+
+struct SynthOptions {
+  std::string layout = "soundspaces";  // "soundspaces" | "raf"
+  std::string out_dir;
+  uint64_t seed = 0;
+  bool force = false;     // write into a non-empty out_dir (files are replaced atomically)
+  bool progress = true;   // progress bars on stderr
+  std::string hrtf_path;  // SOFA file for binaural RIRs; empty: Hrtf::kDefaultSofa
+};
+
+// One RIR file of the plan.
+struct RirJob {
+  std::string file;         // relative to out_dir: "binaural_rirs/90/12_3.wav", "data/000012/rir.wav"
+  std::string name;         // split entry: "90/12_3" (SoundSpaces), "000012" (RAF)
+  int source = 0;           // index into scene.sources
+  int microphone = 0;       // index into SynthPlan::microphones
+  double mic_yaw_deg = 0;   // receiver heading (SoundSpaces); 0 for RAF's omni microphones
+};
+
+struct SynthPlan {
+  std::string layout;
+  int sample_rate = 0;
+  bool binaural = false;
+  std::vector<Vec3> microphones;  // SoundSpaces points 0..M-1 (sources follow as M..M+S-1)
+  std::vector<double> headings_deg;
+  std::vector<RirJob> jobs;
+  std::vector<CameraView> train_cameras, eval_cameras;
+};
+
+// What a layout will write (no pictures or audio are computed). Throws neraf::Error for an
+// unknown layout.
+SynthPlan plan_synthesis(const Scene& scene, const std::string& layout, uint64_t seed);
+
+struct SynthSummary {
+  std::string layout, out_dir;
+  int sample_rate = 0, channels = 0;
+  int num_microphones = 0, num_headings = 0, num_sources = 0;
+  int64_t num_rirs = 0, num_train_rirs = 0, num_test_rirs = 0;
+  int num_train_images = 0, num_eval_images = 0;
+  double gain = 1;        // one scene-wide factor applied to every RIR (see synthesize)
+  double peak = 0;        // largest |sample| written
+  double image_seconds = 0, rir_seconds = 0, total_seconds = 0;
+};
+
+// Writes the dataset. Refuses a non-empty out_dir unless options.force. Every RIR is scaled by one
+// scene-wide gain = min(1, 0.5 / peak of the closest source-microphone pairs) so no sample clips
+// in NeRAF's loaders (which clip to [-1, 1]) and relative levels stay physical; the gain is recorded
+// in synth_info.json.
+SynthSummary synthesize(const Scene& scene, const SynthOptions& options);
+
+}  // namespace neraf::sim

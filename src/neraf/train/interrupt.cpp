@@ -1,0 +1,39 @@
+#include "neraf/train/interrupt.h"
+
+#include <stdexcept>
+
+namespace neraf::train {
+
+namespace {
+// The one unavoidable static: a POSIX signal handler takes no user argument, so it can only reach
+// the active guard's flag through a process-wide pointer. It is set and cleared by the guard's
+// constructor/destructor only; lock-free atomics are async-signal-safe.
+std::atomic<std::atomic<bool>*> g_active_flag{nullptr};
+
+extern "C" void on_interrupt(int sig) {
+  std::atomic<bool>* flag = g_active_flag.load();
+  if (flag) flag->store(true);
+  // The next signal of this kind terminates the process as usual.
+  signal(sig, SIG_DFL);
+}
+}  // namespace
+
+InterruptGuard::InterruptGuard() {
+  std::atomic<bool>* expected = nullptr;
+  if (!g_active_flag.compare_exchange_strong(expected, &flag_))
+    throw std::logic_error("InterruptGuard: only one may be active at a time");
+  struct sigaction sa {};
+  sa.sa_handler = on_interrupt;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = 0;
+  sigaction(SIGINT, &sa, &old_int_);
+  sigaction(SIGTERM, &sa, &old_term_);
+}
+
+InterruptGuard::~InterruptGuard() {
+  sigaction(SIGINT, &old_int_, nullptr);
+  sigaction(SIGTERM, &old_term_, nullptr);
+  g_active_flag.store(nullptr);
+}
+
+}  // namespace neraf::train

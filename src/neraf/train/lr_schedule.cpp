@@ -1,0 +1,20 @@
+#include "neraf/train/lr_schedule.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace neraf::train {
+
+double learning_rate(const ScheduleConfig& s, int64_t step) {
+  if (step < s.warmup_steps) {
+    const double x = static_cast<double>(step) / static_cast<double>(s.warmup_steps);
+    const double r = s.warmup_ramp == "sine" ? std::sin(0.5 * M_PI * x) : x;
+    return s.lr_pre_warmup + (s.lr - s.lr_pre_warmup) * r;
+  }
+  const double t = std::clamp(static_cast<double>(step - s.warmup_steps) /
+                                  static_cast<double>(s.max_steps - s.warmup_steps),
+                              0.0, 1.0);
+  return std::exp(std::log(s.lr) * (1.0 - t) + std::log(s.lr_final) * t);
+}
+
+}  // namespace neraf::train

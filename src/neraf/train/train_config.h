@@ -1,0 +1,86 @@
+#pragma once
+// Training configuration: presets `cpu` (default) and `paper`, resolved once and saved beside the
+// run as RUN/config.json (JSON round trip through the same field tables as the model config).
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <string>
+
+#include "neraf/nerf/config.h"
+
+namespace neraf::train {
+
+// What a run trains. Only `vision` is implemented here; `audio` and `joint` are the acoustic
+// branch's (see trainer.h, "Adding a branch").
+enum class Modality { vision, audio, joint };
+std::string to_string(Modality m);
+Modality parse_enum(Modality, const std::string& s, const std::string& where);
+Modality parse_modality(const std::string& s);
+
+// nerfstudio ExponentialDecayScheduler: optional warm-up from lr_pre_warmup (linear, or a sine
+// ramp when warmup_ramp = "sine"), then log-linear from lr to lr_final over
+// [warmup_steps, max_steps], flat afterwards. Adam with this eps (betas 0.9/0.999, no decay).
+struct ScheduleConfig {
+  double lr = 1e-2;
+  double lr_final = 1e-4;
+  int64_t max_steps = 200000;
+  int64_t warmup_steps = 0;
+  double lr_pre_warmup = 1e-8;
+  std::string warmup_ramp = "linear";  // "linear" | "sine"
+  double eps = 1e-15;
+
+  template <class V>
+  void visit(V& v) {
+    v("lr", lr);
+    v("lr_final", lr_final);
+    v("max_steps", max_steps);
+    v("warmup_steps", warmup_steps);
+    v("lr_pre_warmup", lr_pre_warmup);
+    v("warmup_ramp", warmup_ramp);
+    v("eps", eps);
+  }
+};
+
+struct TrainConfig {
+  std::string preset = "cpu";
+  Modality modality = Modality::vision;
+  int64_t steps = 3000;              // total optimisation steps
+  int64_t rays_per_batch = 4096;     // vision rays per step
+  uint64_t seed = 42;
+  int threads = 0;                   // 0: LibTorch's default (all cores)
+  int64_t save_every = 500;          // checkpoint period in steps (and always at the end)
+  int64_t eval_rays_per_chunk = 16384;
+  ScheduleConfig fields;             // "fields" group: the radiance field
+  ScheduleConfig proposal_networks;  // "proposal_networks" group
+  ScheduleConfig camera_opt{1e-3, 1e-4, 5000};
+  nerf::ModelConfig model;
+  // The acoustic branch adds its own config struct here (and a v("audio", audio) line below).
+
+  template <class V>
+  void visit(V& v) {
+    v("preset", preset);
+    v("modality", modality);
+    v("steps", steps);
+    v("rays_per_batch", rays_per_batch);
+    v("seed", seed);
+    v("threads", threads);
+    v("save_every", save_every);
+    v("eval_rays_per_chunk", eval_rays_per_chunk);
+    v("fields", fields);
+    v("proposal_networks", proposal_networks);
+    v("camera_opt", camera_opt);
+    v("model", model);
+  }
+};
+
+// The named preset (throws neraf::Error naming --preset for unknown names).
+TrainConfig train_preset(const std::string& name);
+
+nlohmann::json to_json(const TrainConfig& c);
+// Overlays `j` onto a copy of the preset named in j["preset"] (or `cpu`); `where` names the file.
+TrainConfig train_config_from_json(const nlohmann::json& j, const std::string& where);
+
+// Range checks (neraf::Error "<where>.<key>: ...").
+void validate(const TrainConfig& c, const std::string& where);
+
+}  // namespace neraf::train

@@ -1,0 +1,302 @@
+#include "neraf/train/trainer.h"
+
+#include <ATen/CPUGeneratorImpl.h>
+
+#include <cmath>
+#include <mutex>
+
+#include "neraf/nerf/rays.h"
+#include "neraf/nerf/samplers.h"
+#include "neraf/train/checkpoint.h"
+#include "neraf/train/lr_schedule.h"
+#include "neraf/util/error.h"
+
+namespace neraf::train {
+
+namespace {
+constexpr const char* kFormat = "neraf-checkpoint-1";
+
+// Settings that may differ between a checkpoint and the run loading it: run length and
+// bookkeeping, and the matmul precision (the master weights are fp32 either way).
+nlohmann::json comparable(nlohmann::json j) {
+  for (const char* k : {"steps", "threads", "save_every", "eval_rays_per_chunk"}) j.erase(k);
+  if (j.contains("model")) j["model"].erase("precision");
+  return j;
+}
+}  // namespace
+
+std::string first_difference(const nlohmann::json& a, const nlohmann::json& b,
+                             const std::string& prefix) {
+  if (a.is_object() && b.is_object()) {
+    for (auto it = a.begin(); it != a.end(); ++it) {
+      const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
+      if (!b.contains(it.key())) return key;
+      const std::string d = first_difference(it.value(), b[it.key()], key);
+      if (!d.empty()) return d;
+    }
+    for (auto it = b.begin(); it != b.end(); ++it)
+      if (!a.contains(it.key())) return prefix.empty() ? it.key() : prefix + "." + it.key();
+    return "";
+  }
+  if (a.is_array() && b.is_array() && a.size() == b.size()) {
+    for (size_t i = 0; i < a.size(); ++i) {
+      const std::string d = first_difference(a[i], b[i], prefix + "[" + std::to_string(i) + "]");
+      if (!d.empty()) return d;
+    }
+    return "";
+  }
+  return a == b ? "" : (prefix.empty() ? "(root)" : prefix);
+}
+
+// ---------------------------------------------------------------------------------------------
+// VisionBranch
+
+VisionBranch::VisionBranch(const TrainConfig& config, const data::ImageSplit& train,
+                           torch::Device device)
+    : config_(config), device_(device) {
+  require(train.size() >= 1, "dataset: the train split is empty; add train_ frames");
+  require(train.images.defined() && train.images.dim() == 4 && train.images.size(3) == 3 &&
+              train.images.scalar_type() == torch::kUInt8,
+          "dataset: training images were not loaded (expected [N, H, W, 3] uint8 pixels)");
+  require(static_cast<int64_t>(train.intrinsics.size()) == train.size(),
+          "dataset: one intrinsics entry per training frame is required");
+  num_images_ = train.images.size(0);
+  height_ = train.images.size(1);
+  width_ = train.images.size(2);
+  pixels_ = train.images.reshape({-1, 3}).to(device);
+  c2w_ = train.camera_to_world.to(torch::kFloat32).to(device);
+  std::vector<torch::Tensor> rows;
+  for (const auto& k : train.intrinsics) rows.push_back(nerf::intrinsics_row(k));
+  intr_ = torch::stack(rows).to(device);
+  model_ = nerf::NerfactoModel(config.model, num_images_, config.seed);
+  model_->to(device);
+  model_->train();
+}
+
+std::vector<ParamGroup> VisionBranch::param_groups() {
+  return {{"proposal_networks", model_->proposal_parameters(), config_.proposal_networks},
+          {"fields", model_->field_parameters(), config_.fields},
+          {"camera_opt", model_->camera_parameters(), config_.camera_opt}};
+}
+
+void VisionBranch::set_training(bool training) { model_->train(training); }
+
+LossDict VisionBranch::losses(StepContext& ctx) {
+  const int64_t R = config_.rays_per_batch;
+  const int64_t per_image = height_ * width_;
+  // Uniform random pixels over all training images (nerfstudio's PixelSampler).
+  const torch::Tensor idx =
+      torch::randint(0, num_images_ * per_image, {R}, ctx.gen, torch::kInt64).to(device_);
+  const torch::Tensor img = torch::div(idx, per_image, "floor");
+  const torch::Tensor rem = idx - img * per_image;
+  const torch::Tensor row = torch::div(rem, width_, "floor");
+  const torch::Tensor col = rem - row * width_;
+  const torch::Tensor gt = pixels_.index_select(0, idx).to(torch::kFloat32) / 255.0;  // [R, 3]
+
+  nerf::RayBundle rays = nerf::rays_from_pixels(
+      c2w_.index_select(0, img), intr_.index_select(0, img), col.to(torch::kFloat32) + 0.5,
+      row.to(torch::kFloat32) + 0.5);
+  rays.camera_indices = img;
+
+  const auto& sc = config_.model.sampler;
+  const nerf::ProposalUpdate pu = nerf::proposal_update(
+      ctx.step, steps_since_update_, sc.proposal_update_every, sc.proposal_warmup);
+  steps_since_update_ = pu.steps_since_update;
+  const double anneal = sc.use_proposal_weight_anneal
+                            ? nerf::proposal_weight_anneal(ctx.step,
+                                                           sc.proposal_weights_anneal_slope,
+                                                           sc.proposal_weights_anneal_max_num_iters)
+                            : 1.0;
+  const nerf::ModelOutputs out = model_->forward(rays, {pu.update, anneal, &ctx.gen});
+  LossDict l = model_->losses(out, gt);
+  const double mse = l.at("rgb_loss").item<double>();
+  ctx.metrics["psnr"] = -10.0 * std::log10(std::max(mse, 1e-12));
+  return l;
+}
+
+void VisionBranch::save(torch::serialize::OutputArchive& archive) {
+  torch::serialize::OutputArchive model_archive;
+  model_->save(model_archive);
+  archive.write("model", model_archive);
+  archive.write("steps_since_update", torch::tensor(steps_since_update_, torch::kInt64));
+}
+
+void VisionBranch::load(torch::serialize::InputArchive& archive, const std::string& where) {
+  torch::serialize::InputArchive model_archive;
+  archive.read("model", model_archive);
+  load_module(*model_, model_archive, where);
+  model_->to(device_);
+  torch::Tensor s;
+  archive.read("steps_since_update", s);
+  steps_since_update_ = s.item<int64_t>();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Trainer
+
+Trainer::Trainer(TrainConfig config, torch::Device device)
+    : config_(std::move(config)),
+      device_(device),
+      gen_(at::make_generator<at::CPUGeneratorImpl>(config_.seed)) {}
+
+void Trainer::add_branch(std::unique_ptr<Branch> branch) {
+  TORCH_CHECK(groups_.empty(), "add_branch: optimizers were already built");
+  branches_.push_back(std::move(branch));
+}
+
+void Trainer::build_optimizers() {
+  for (auto& b : branches_)
+    for (auto& g : b->param_groups()) {
+      if (g.params.empty()) continue;  // e.g. camera_opt when the pose optimizer is off
+      Group group;
+      group.name = g.name;
+      group.schedule = g.schedule;
+      group.params = g.params;
+      group.optimizer = std::make_unique<torch::optim::Adam>(
+          g.params, torch::optim::AdamOptions(g.schedule.lr).eps(g.schedule.eps));
+      groups_.push_back(std::move(group));
+    }
+}
+
+VisionBranch* Trainer::vision() { return dynamic_cast<VisionBranch*>(branch("vision")); }
+
+Branch* Trainer::branch(const std::string& name) {
+  for (auto& b : branches_)
+    if (b->name() == name) return b.get();
+  return nullptr;
+}
+
+double Trainer::group_lr(const std::string& name) const {
+  for (const auto& g : groups_)
+    if (g.name == name) return learning_rate(g.schedule, step_);
+  return 0.0;
+}
+
+StepResult Trainer::step() {
+  if (groups_.empty()) build_optimizers();
+  for (auto& g : groups_) {
+    const double lr = learning_rate(g.schedule, step_);
+    for (auto& pg : g.optimizer->param_groups())
+      static_cast<torch::optim::AdamOptions&>(pg.options()).lr(lr);
+  }
+  // Gradients are reset to "none" (PyTorch's zero_grad(set_to_none=True)), so parameters that
+  // take no part in this step's graph (the proposal nets between updates) are skipped by Adam
+  // instead of being moved by their decaying moments.
+  for (auto& g : groups_)
+    for (auto& p : g.params) p.mutable_grad() = torch::Tensor();
+
+  StepResult result;
+  StepContext ctx{step_, gen_, result.metrics};
+  LossDict all;
+  for (auto& b : branches_) {
+    for (auto& [k, v] : b->losses(ctx)) {
+      TORCH_CHECK(!all.count(k), "two branches report the loss '", k, "'");
+      all[k] = v;
+    }
+    result.rays += b->rays_per_step();
+  }
+  if (!all.empty()) {
+    torch::Tensor total = torch::zeros({}, all.begin()->second.options());
+    for (const auto& [k, v] : all) total = total + v;
+    if (total.requires_grad()) total.backward();
+    for (auto& g : groups_) g.optimizer->step();
+    for (const auto& [k, v] : all) result.losses[k] = v.item<double>();
+    result.loss = total.item<double>();
+  }
+  result.step = ++step_;
+  return result;
+}
+
+void Trainer::save_checkpoint(const std::string& path) {
+  if (groups_.empty()) build_optimizers();
+  torch::serialize::OutputArchive a;
+  a.write("format", c10::IValue(std::string(kFormat)));
+  a.write("config", c10::IValue(to_json(config_).dump()));
+  a.write("step", torch::tensor(step_, torch::kInt64));
+  {
+    std::lock_guard<std::mutex> lock(gen_.mutex());
+    a.write("rng", gen_.get_state());
+  }
+  for (auto& b : branches_) {
+    torch::serialize::OutputArchive sub;
+    b->save(sub);
+    a.write("branch_" + b->name(), sub);
+  }
+  for (auto& g : groups_) {
+    torch::serialize::OutputArchive sub;
+    g.optimizer->save(sub);
+    a.write("optim_" + g.name, sub);
+  }
+  save_archive(a, path);
+}
+
+void Trainer::load_checkpoint(const std::string& path) {
+  if (groups_.empty()) build_optimizers();
+  torch::serialize::InputArchive a;
+  load_archive(a, path);
+  check_checkpoint_header(a, config_, path);
+  try {
+    torch::Tensor step, rng;
+    a.read("step", step);
+    a.read("rng", rng);
+    for (auto& b : branches_) {
+      torch::serialize::InputArchive sub;
+      a.read("branch_" + b->name(), sub);
+      b->load(sub, path);
+    }
+    for (auto& g : groups_) {
+      torch::serialize::InputArchive sub;
+      a.read("optim_" + g.name, sub);
+      g.optimizer->load(sub);
+    }
+    step_ = step.item<int64_t>();
+    std::lock_guard<std::mutex> lock(gen_.mutex());
+    gen_.set_state(rng);
+  } catch (const c10::Error& e) {
+    std::string what = e.what_without_backtrace();
+    what = what.substr(0, what.find('\n'));
+    throw Error(path + ": checkpoint does not match this model (" + what +
+                "); it was written by another version or for another dataset");
+  }
+}
+
+nlohmann::json check_checkpoint_header(torch::serialize::InputArchive& a, const TrainConfig& config,
+                                       const std::string& path) {
+  nlohmann::json stored;
+  try {
+    c10::IValue fmt;
+    require(a.try_read("format", fmt) && fmt.isString() && fmt.toStringRef() == kFormat,
+            path + ": not a neraf training checkpoint; point --run at a folder made by neraf train");
+    c10::IValue cfg;
+    a.read("config", cfg);
+    stored = nlohmann::json::parse(cfg.toStringRef());
+  } catch (const c10::Error&) {
+    throw Error(path + ": checkpoint header is unreadable (corrupted file); delete it");
+  } catch (const nlohmann::json::exception&) {
+    throw Error(path + ": checkpoint config is corrupted; delete the file");
+  }
+  const nlohmann::json mine = to_json(config);
+  if (stored.value("preset", "") != config.preset)
+    throw Error(path + ": checkpoint was trained with --preset " + stored.value("preset", "?") +
+                ", this run uses --preset " + config.preset +
+                "; use the same preset or a new --out folder");
+  const std::string diff = first_difference(comparable(stored), comparable(mine));
+  if (!diff.empty())
+    throw Error(path + ": checkpoint was trained with a different config (" + diff +
+                " differs); use the run's own config.json or a new --out folder");
+  return stored;
+}
+
+std::unique_ptr<Trainer> make_trainer(const TrainConfig& config, const data::ImageSet* images,
+                                      torch::Device device) {
+  validate(config, "config");
+  auto trainer = std::make_unique<Trainer>(config, device);
+  if (config.modality != Modality::vision)
+    throw Error("--modality " + to_string(config.modality) +
+                ": the acoustic branch is not available in this build yet; use --modality vision");
+  require(images != nullptr, "--data: a vision run needs posed images (transforms.json)");
+  trainer->add_branch(std::make_unique<VisionBranch>(config, images->train, device));
+  return trainer;
+}
+
+}  // namespace neraf::train

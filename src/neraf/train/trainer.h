@@ -1,0 +1,159 @@
+#pragma once
+// The trainer: a step function over "branches" (vision now; the acoustic branch plugs in the
+// same way), one Adam optimizer per named parameter group with a pure-function LR schedule,
+// and resumable checkpoints.
+//
+// Adding a branch (e.g. audio, issue 5):
+//   1. Subclass `Branch`: name() ("audio"), param_groups() (e.g. "audio_fields" — NeRAF also puts
+//      the radiance field's parameters in that group, reachable through
+//      `trainer.vision()->model()->field`), losses(ctx) returning named scalar losses (an empty
+//      dict before `start_step_audio`), save()/load() for its modules and non-parameter state.
+//   2. In `make_trainer` (trainer.cpp) construct it for Modality::audio / joint and
+//      `add_branch` it after the vision branch. Branches run in insertion order each step, so the
+//      audio branch sees the vision branch's step already taken (grid updates can go in
+//      `Branch::losses` of the audio branch).
+//   3. Put its config struct in TrainConfig (train_config.h) and its eval in evaluation.h.
+// Everything else (optimizers, schedules, checkpoints, resume, SIGINT, progress) is generic.
+#include <torch/torch.h>
+
+#include <atomic>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "neraf/data/image_set.h"
+#include "neraf/nerf/nerfacto_model.h"
+#include "neraf/train/train_config.h"
+
+namespace neraf::train {
+
+using LossDict = nerf::LossDict;
+
+// A named set of parameters with its own Adam optimizer and LR schedule (nerfstudio's optimizer
+// groups: "fields", "proposal_networks", "camera_opt"; NeRAF adds "audio_fields"). A parameter
+// may appear in several groups (each group keeps its own Adam moments, as NeRAF does).
+struct ParamGroup {
+  std::string name;
+  std::vector<torch::Tensor> params;
+  ScheduleConfig schedule;
+};
+
+// What a branch sees during a step.
+struct StepContext {
+  int64_t step;                            // index of the step being taken (0-based)
+  at::Generator& gen;                      // the run's random stream (checkpointed)
+  std::map<std::string, double>& metrics;  // scalars to report (e.g. "psnr")
+};
+
+class Branch {
+ public:
+  virtual ~Branch() = default;
+  virtual std::string name() const = 0;  // checkpoint key prefix: "vision", "audio"
+  virtual std::vector<ParamGroup> param_groups() = 0;
+  // Forward pass and named losses for this step (summed with the other branches' losses into the
+  // objective). May return an empty dict (branch inactive this step).
+  virtual LossDict losses(StepContext& ctx) = 0;
+  virtual int64_t rays_per_step() const { return 0; }  // throughput report (vision rays)
+  virtual void set_training(bool training) = 0;
+  virtual void save(torch::serialize::OutputArchive& archive) = 0;
+  // `where` names the checkpoint file for error messages.
+  virtual void load(torch::serialize::InputArchive& archive, const std::string& where) = 0;
+};
+
+// Nerfacto on posed images: random pixels over all training images each step.
+class VisionBranch : public Branch {
+ public:
+  VisionBranch(const TrainConfig& config, const data::ImageSplit& train, torch::Device device);
+
+  std::string name() const override { return "vision"; }
+  std::vector<ParamGroup> param_groups() override;
+  LossDict losses(StepContext& ctx) override;
+  int64_t rays_per_step() const override { return config_.rays_per_batch; }
+  void set_training(bool training) override;
+  void save(torch::serialize::OutputArchive& archive) override;
+  void load(torch::serialize::InputArchive& archive, const std::string& where) override;
+
+  nerf::NerfactoModel& model() { return model_; }
+  // The proposal-schedule state (nerfstudio's steps_since_update).
+  int64_t steps_since_update() const { return steps_since_update_; }
+
+ private:
+  TrainConfig config_;
+  torch::Device device_;
+  nerf::NerfactoModel model_{nullptr};
+  torch::Tensor pixels_;  // [N·H·W, 3] uint8 on device
+  torch::Tensor c2w_;     // [N, 3, 4]
+  torch::Tensor intr_;    // [N, 9] (nerf::intrinsics_row)
+  int64_t num_images_ = 0, height_ = 0, width_ = 0;
+  int64_t steps_since_update_ = 0;
+};
+
+struct StepResult {
+  int64_t step = 0;                       // steps completed after this one
+  std::map<std::string, double> losses;   // each named loss
+  double loss = 0;                        // their sum
+  std::map<std::string, double> metrics;  // e.g. "psnr" of the training batch
+  int64_t rays = 0;                       // vision rays this step
+};
+
+class Trainer {
+ public:
+  Trainer(TrainConfig config, torch::Device device);
+
+  // Branches must be added before the first step and before load_checkpoint.
+  void add_branch(std::unique_ptr<Branch> branch);
+
+  // One optimisation step: LRs from the schedules, zero grads, every branch's losses, backward,
+  // every optimizer steps.
+  StepResult step();
+  int64_t completed_steps() const { return step_; }
+
+  // Archive layout: "format", "config" (resolved JSON), "step", "rng", "branch/<name>",
+  // "optim/<group>". Loading checks that the stored config describes the same model (preset,
+  // model, modality) and throws neraf::Error naming the file and the first differing setting.
+  void save_checkpoint(const std::string& path);
+  void load_checkpoint(const std::string& path);
+
+  const TrainConfig& config() const { return config_; }
+  void set_total_steps(int64_t steps) { config_.steps = steps; }
+  VisionBranch* vision();  // nullptr when the run has no vision branch
+  Branch* branch(const std::string& name);
+  at::Generator& generator() { return gen_; }
+  // Current learning rate of a group (for logs and tests).
+  double group_lr(const std::string& name) const;
+
+ private:
+  void build_optimizers();
+
+  struct Group {
+    std::string name;
+    ScheduleConfig schedule;
+    std::vector<torch::Tensor> params;
+    std::unique_ptr<torch::optim::Adam> optimizer;
+  };
+
+  TrainConfig config_;
+  torch::Device device_;
+  std::vector<std::unique_ptr<Branch>> branches_;
+  std::vector<Group> groups_;
+  at::Generator gen_;
+  int64_t step_ = 0;
+};
+
+// The trainer for `config.modality` with its branches. Vision needs `images`; audio/joint are
+// not implemented yet (neraf::Error).
+std::unique_ptr<Trainer> make_trainer(const TrainConfig& config, const data::ImageSet* images,
+                                      torch::Device device);
+
+// Reads a checkpoint's header ("format" and the resolved config) and checks that it describes
+// the same model as `config` (preset, modality, model settings except precision); neraf::Error
+// naming `path` and the first differing setting otherwise. Returns the stored config JSON.
+nlohmann::json check_checkpoint_header(torch::serialize::InputArchive& archive,
+                                       const TrainConfig& config, const std::string& path);
+
+// The one key of `a` and `b` (JSON objects) that differs first, as a dotted path ("" if equal).
+std::string first_difference(const nlohmann::json& a, const nlohmann::json& b,
+                             const std::string& prefix = "");
+
+}  // namespace neraf::train

@@ -1,0 +1,95 @@
+#include "neraf/acoustic/losses.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+namespace neraf::acoustic {
+namespace {
+
+TEST(AudioLoss, HandComputedScAndSl) {
+  // pred log-mags (0, ln 2), gt (ln 3, 0): X = (0.999, 1.999), Y = (2.999, 0.999), Y − X = (2, −1).
+  const auto pred = torch::tensor({0.0, std::log(2.0)}, torch::kFloat32).view({1, 1, 2});
+  const auto gt = torch::tensor({std::log(3.0), 0.0}, torch::kFloat32).view({1, 1, 2});
+  const auto t = sc_slmse_loss(pred, gt);
+  const double sc = std::sqrt(5.0) / std::sqrt(2.999 * 2.999 + 0.999 * 0.999);  // 0.7073897
+  const double sl = (std::log(3.0) * std::log(3.0) + std::log(2.0) * std::log(2.0)) / 2.0;
+  EXPECT_NEAR(t.sc.item<double>(), sc, 1e-6);
+  EXPECT_NEAR(t.sc.item<double>(), 0.7073897, 1e-6);
+  EXPECT_NEAR(t.sl.item<double>(), sl, 1e-6);
+  EXPECT_NEAR(t.sl.item<double>(), 0.8437010, 1e-6);
+  EXPECT_NEAR(t.sc_loss.item<double>(), 1e-4 * sc, 1e-10);  // 1e-3 · 0.1
+  EXPECT_NEAR(t.mag_loss.item<double>(), 1e-3 * sl, 1e-10);
+  EXPECT_NEAR(t.total.item<double>(), 1e-4 * sc + 1e-3 * sl, 1e-10);
+}
+
+TEST(AudioLoss, ScIsOneRatioOverTheWholeBatch) {
+  torch::manual_seed(0);
+  const auto pred = torch::randn({4, 2, 9});
+  auto gt = torch::randn({4, 2, 9});
+  gt[0] += 3.0;  // one loud sample dominates the batch norm
+  const auto t = sc_slmse_loss(pred, gt);
+  const auto x = torch::exp(pred.to(torch::kFloat64)) - 1e-3;
+  const auto y = torch::exp(gt.to(torch::kFloat64)) - 1e-3;
+  const double whole = ((y - x).pow(2).sum().sqrt() / y.pow(2).sum().sqrt()).item<double>();
+  double per_sample = 0.0;
+  for (int b = 0; b < 4; ++b) {
+    per_sample += ((y[b] - x[b]).pow(2).sum().sqrt() / y[b].pow(2).sum().sqrt()).item<double>() / 4;
+  }
+  EXPECT_NEAR(t.sc.item<double>(), whole, 1e-5 * whole);
+  EXPECT_GT(std::abs(whole - per_sample), 1e-2);
+  // No clipping: pred below log(1e-3) gives a negative X and still counts.
+  const auto low = torch::full({1, 1, 1}, -10.0);
+  const auto one = torch::zeros({1, 1, 1});
+  const double xl = std::exp(-10.0) - 1e-3;  // < 0
+  EXPECT_NEAR(sc_slmse_loss(low, one).sc.item<double>(), std::abs(0.999 - xl) / 0.999, 1e-6);
+}
+
+TEST(AudioLoss, WeightsAreConfigurableAndGradientFlows) {
+  AudioLossOptions o;
+  o.loss_factor = 1.0;
+  o.sc_weight = 2.0;
+  o.mag_weight = 0.5;
+  auto pred = torch::zeros({2, 1, 3}, torch::requires_grad());
+  const auto gt = torch::ones({2, 1, 3});
+  const auto t = sc_slmse_loss(pred, gt, o);
+  EXPECT_NEAR(t.mag_loss.item<double>(), 0.5, 1e-6);  // mean((1 − 0)²)·0.5
+  EXPECT_NEAR(t.sc_loss.item<double>(), 2.0 * t.sc.item<double>(), 1e-6);
+  t.total.backward();
+  EXPECT_LT(pred.grad().max().item<float>(), 0.0f);  // raising pred towards gt lowers the loss
+}
+
+TEST(EnergyDecayLoss, HandComputed) {
+  // One RIR, one channel, F = 2, T = 3. Magnitudes M = exp(L) − 1e-3.
+  const double mp[2][3] = {{1.0, 0.5, 0.25}, {0.0, 0.5, 0.0}};
+  const double mg[2][3] = {{2.0, 0.5, 0.1}, {0.0, 0.0, 0.1}};
+  auto to_log = [](const double m[2][3]) {
+    auto t = torch::empty({1, 1, 2, 3}, torch::kFloat64);
+    for (int f = 0; f < 2; ++f)
+      for (int k = 0; k < 3; ++k) t[0][0][f][k] = std::log(m[f][k] + 1e-3);
+    return t;
+  };
+  // E_p = (1, 0.5, 0.0625) → D_p = (1.5625, 0.5625, 0.0625); E_g = (4, 0.25, 0.02) →
+  // D_g = (4.27, 0.27, 0.02).
+  const double dp[3] = {1.5625, 0.5625, 0.0625}, dg[3] = {4.27, 0.27, 0.02};
+  double want = 0;
+  for (int k = 0; k < 3; ++k) want += std::abs(std::log10(dp[k]) - std::log10(dg[k])) / 3.0;
+  EXPECT_NEAR(energy_decay_loss(to_log(mp), to_log(mg)).item<double>(), want, 1e-5);
+  EXPECT_NEAR(want, 0.416739, 1e-5);
+  EXPECT_NEAR(energy_decay_loss(to_log(mg), to_log(mg)).item<double>(), 0.0, 1e-7);
+}
+
+TEST(EnergyDecayLoss, SilentTailStaysFiniteAndDifferentiable) {
+  auto pred = torch::full({2, 1, 4, 5}, std::log(1e-3), torch::requires_grad());  // M = 0
+  const auto gt = torch::zeros({2, 1, 4, 5});
+  const auto l = energy_decay_loss(pred, gt);
+  EXPECT_TRUE(std::isfinite(l.item<double>()));
+  l.backward();
+  EXPECT_TRUE(torch::isfinite(pred.grad()).all().item<bool>());
+  EXPECT_THROW(energy_decay_loss(torch::zeros({2, 4, 5}), torch::zeros({2, 4, 5})),
+               std::exception);
+}
+
+}  // namespace
+}  // namespace neraf::acoustic

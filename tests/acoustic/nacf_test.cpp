@@ -1,0 +1,164 @@
+#include "neraf/acoustic/nacf.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include "neraf/acoustic/positional_encoding.h"
+
+namespace neraf::acoustic {
+namespace {
+
+using torch::indexing::Slice;
+
+TEST(Nacf, PaperParameterCounts) {
+  Nacf ss(nacf_paper_options(2, 257));
+  EXPECT_EQ(ss->options().in_features(), 1187);
+  EXPECT_EQ(ss->trunk_parameter_count(), 20165280);
+  EXPECT_EQ(ss->head_parameter_count(), 263682);
+  Nacf raf(nacf_paper_options(1, 513));
+  EXPECT_EQ(raf->head_parameter_count(), 263169);
+  // Layer widths as in the published code (5096, not 4096).
+  const auto p = ss->named_parameters();
+  EXPECT_EQ(p["soundfield.0.weight"].sizes(), (std::vector<int64_t>{5096, 1187}));
+  EXPECT_EQ(p["soundfield.4.weight"].sizes(), (std::vector<int64_t>{512, 1024}));
+  EXPECT_EQ(p["STFT_linear.1.weight"].sizes(), (std::vector<int64_t>{257, 512}));
+}
+
+TEST(Nacf, DefaultLinearInitBounds) {
+  torch::manual_seed(0);
+  Nacf net(nacf_cpu_options(1, 513, 256));
+  const auto p = net->named_parameters();
+  // PyTorch default: kaiming_uniform(a=√5) → U(±1/√fan_in) for weights, U(±1/√fan_in) for biases.
+  const double bound = 1.0 / std::sqrt(static_cast<double>(256 + kPoseEncodingDim));
+  EXPECT_LE(p["soundfield.0.weight"].abs().max().item<double>(), bound);
+  EXPECT_GT(p["soundfield.0.weight"].abs().max().item<double>(), 0.99 * bound);
+  EXPECT_LE(p["soundfield.0.bias"].abs().max().item<double>(), bound);
+}
+
+TEST(Nacf, ShapesAndTanhRange) {
+  torch::manual_seed(1);
+  Nacf net(nacf_cpu_options(2, 257, 256));
+  EXPECT_EQ(net->options().in_features(), 256 + 163);
+  const auto h = torch::randn({5, 419});
+  const auto y = net->forward(h);
+  ASSERT_EQ(y.sizes(), (std::vector<int64_t>{5, 2, 257}));
+  // Push the heads into saturation: outputs stay strictly inside (−10, 10) and reach ±10 closely.
+  {
+    torch::NoGradGuard g;
+    for (auto& kv : net->named_parameters()) {
+      if (kv.key().rfind("STFT_linear.0.bias", 0) == 0) kv.value().fill_(50.0);
+      if (kv.key().rfind("STFT_linear.1.bias", 0) == 0) kv.value().fill_(-50.0);
+    }
+  }
+  const auto s = net->forward(h);
+  EXPECT_LE(s.abs().max().item<float>(), 10.0f);
+  EXPECT_NEAR(s.select(1, 0).min().item<float>(), 10.0f, 1e-3);
+  EXPECT_NEAR(s.select(1, 1).max().item<float>(), -10.0f, 1e-3);
+  // Channel c comes from head c only.
+  const auto y0 = net->forward(h);
+  EXPECT_GT(y0.select(1, 0).min().item<float>(), 0.0f);
+  EXPECT_LT(y0.select(1, 1).max().item<float>(), 0.0f);
+}
+
+TEST(Nacf, EncodersHandValues) {
+  // Rot θ = 90°: stored (0.5, 0.5, 1) → tcnn maps 2v − 1 → (0, 0, 1).
+  const auto r90 = encode_rot(torch::tensor({0.5, 0.5, 1.0}, torch::kFloat64).view({1, 3}));
+  ASSERT_EQ(r90.sizes(), (std::vector<int64_t>{1, 16}));
+  std::vector<double> want(16, 0.0);
+  want[0] = 0.28209479;
+  want[2] = 0.48860251;
+  want[6] = 0.94617470 - 0.31539157;
+  want[12] = 0.37317633 * 2.0;
+  for (int i = 0; i < 16; ++i) EXPECT_NEAR(r90[0][i].item<float>(), want[i], 1e-6) << i;
+  // θ = 0°: stored (1, 0.5, 0.5) → (1, 0, 0).
+  const auto r0 = encode_rot(torch::tensor({1.0, 0.5, 0.5}, torch::kFloat64).view({1, 3}));
+  std::fill(want.begin(), want.end(), 0.0);
+  want[0] = 0.28209479;
+  want[3] = -0.48860251;
+  want[6] = -0.31539157;
+  want[8] = 0.54627422;
+  want[13] = 0.45704580;
+  want[15] = -0.59004359;
+  for (int i = 0; i < 16; ++i) EXPECT_NEAR(r0[0][i].item<float>(), want[i], 1e-6) << i;
+
+  // Out-of-box positions arrive as zero vectors: sin 0, cos 1, raw 0.
+  const auto p0 = encode_position(torch::zeros({1, 3}, torch::kFloat64));
+  ASSERT_EQ(p0.sizes(), (std::vector<int64_t>{1, 63}));
+  EXPECT_EQ(p0.scalar_type(), torch::kFloat32);
+  EXPECT_NEAR(p0.slice(1, 0, 30).abs().max().item<float>(), 0.0f, 1e-7);
+  EXPECT_NEAR(p0.slice(1, 30, 60).min().item<float>(), 1.0f, 1e-7);
+  // Time: t/(max_len − 1); frame 39 of 79 → 0.5 → sin(π·f).
+  const auto te = encode_time(torch::tensor({39}, torch::kInt64), 79);
+  ASSERT_EQ(te.sizes(), (std::vector<int64_t>{1, 21}));
+  EXPECT_NEAR(te[0][0].item<float>(), 0.0f, 1e-6);    // sin(π)
+  EXPECT_NEAR(te[0][10].item<float>(), -1.0f, 1e-6);  // cos(π)
+  EXPECT_FLOAT_EQ(te[0][20].item<float>(), 0.5f);
+}
+
+TEST(Nacf, InputOrderWithAndWithoutGrid) {
+  const int64_t b = 3, g = 8, max_len = 60;
+  const auto feature = torch::arange(g, torch::kFloat32) + 100.0;
+  const auto t = torch::tensor({0, 17, 59}, torch::kInt64);
+  const auto mic = torch::rand({b, 3}, torch::kFloat64);
+  const auto src = torch::rand({b, 3}, torch::kFloat64);
+  const auto rot = torch::rand({b, 3}, torch::kFloat64);
+  const auto h = nacf_input(feature, t, max_len, mic, src, rot);
+  ASSERT_EQ(h.sizes(), (std::vector<int64_t>{b, g + 163}));
+  EXPECT_EQ(h.scalar_type(), torch::kFloat32);
+  const auto te = encode_time(t, max_len), me = encode_position(mic), se = encode_position(src),
+             re = encode_rot(rot);
+  EXPECT_TRUE(torch::equal(h.slice(1, 0, g), feature.expand({b, g})));
+  EXPECT_TRUE(torch::equal(h.slice(1, g, g + 21), te));
+  EXPECT_TRUE(torch::equal(h.slice(1, g + 21, g + 84), me));
+  EXPECT_TRUE(torch::equal(h.slice(1, g + 84, g + 147), se));
+  EXPECT_TRUE(torch::equal(h.slice(1, g + 147, g + 163), re));
+  // Raw inputs sit at the end of each NeRF encoding block.
+  EXPECT_FLOAT_EQ(h[1][g + 20].item<float>(), 17.0f / 59.0f);
+  EXPECT_FLOAT_EQ(h[2][g + 21 + 60].item<float>(), static_cast<float>(mic[2][0].item<double>()));
+
+  // No grid: [mic, source, time, rot].
+  const auto n = nacf_input(torch::Tensor(), t, max_len, mic, src, rot);
+  ASSERT_EQ(n.sizes(), (std::vector<int64_t>{b, 163}));
+  EXPECT_TRUE(torch::equal(n.slice(1, 0, 63), me));
+  EXPECT_TRUE(torch::equal(n.slice(1, 63, 126), se));
+  EXPECT_TRUE(torch::equal(n.slice(1, 126, 147), te));
+  EXPECT_TRUE(torch::equal(n.slice(1, 147, 163), re));
+
+  // A per-sample grid feature [B, G] is accepted as is.
+  const auto per = torch::rand({b, g});
+  EXPECT_TRUE(torch::equal(nacf_input(per, t, max_len, mic, src, rot).slice(1, 0, g), per));
+  EXPECT_THROW(nacf_input(torch::rand({2, g}), t, max_len, mic, src, rot), std::exception);
+}
+
+TEST(Nacf, Bf16TrunkTracksFp32) {
+  torch::manual_seed(4);
+  NacfOptions o = nacf_cpu_options(2, 257, 256);
+  Nacf net(o);
+  const auto h = torch::randn({256, o.in_features()});
+  const auto ref = net->forward(h);
+  o.bf16 = true;
+  Nacf low(o);
+  {
+    torch::NoGradGuard g;
+    auto dst = low->parameters();
+    auto src = net->parameters();
+    for (size_t i = 0; i < dst.size(); ++i) dst[i].copy_(src[i]);
+  }
+  const auto out = low->forward(h);
+  EXPECT_EQ(out.scalar_type(), torch::kFloat32);
+  const double scale = ref.abs().mean().item<double>();
+  const double err = (out - ref).abs().mean().item<double>();
+  // bf16 keeps 8 mantissa bits (2^-9 ≈ 2e-3 relative rounding per operand).
+  EXPECT_LT(err / scale, 1.5e-2) << "mean |bf16 − fp32| = " << err << ", mean |fp32| = " << scale;
+  // Gradients land on the fp32 master weights.
+  out.pow(2).mean().backward();
+  for (const auto& p : low->parameters()) {
+    ASSERT_TRUE(p.grad().defined());
+    EXPECT_EQ(p.grad().scalar_type(), torch::kFloat32);
+  }
+}
+
+}  // namespace
+}  // namespace neraf::acoustic

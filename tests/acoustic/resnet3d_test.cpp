@@ -1,0 +1,127 @@
+#include "neraf/acoustic/resnet3d.h"
+
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+namespace neraf::acoustic {
+namespace {
+
+int64_t count_parameters(torch::nn::Module& m) {
+  int64_t n = 0;
+  for (const auto& p : m.parameters()) n += p.numel();
+  return n;
+}
+
+// Independent arithmetic for a bottleneck ResNet3D (no biases in convs; BN has weight + bias).
+int64_t bottleneck_resnet_params(int64_t in_ch, int64_t stem, int64_t k, std::vector<int64_t> layers,
+                                 std::vector<int64_t> planes) {
+  auto bn = [](int64_t c) { return 2 * c; };
+  int64_t n = in_ch * stem * k * k * k + bn(stem);
+  int64_t in = stem;
+  for (size_t s = 0; s < layers.size(); ++s) {
+    const int64_t p = planes[s], out = 4 * p;
+    for (int64_t b = 0; b < layers[s]; ++b) {
+      n += in * p + bn(p) + p * p * 27 + bn(p) + p * out + bn(out);
+      if (b == 0) n += in * out + bn(out);  // downsample (channel change on every first block)
+      in = out;
+    }
+  }
+  return n;
+}
+
+TEST(ResNet3d, PaperParameterCount) {
+  ResNet3d net(resnet3d_paper_options());
+  const int64_t expected = bottleneck_resnet_params(7, 64, 5, {3, 4, 6}, {64, 128, 256});
+  EXPECT_EQ(expected, 17068608);  // "≈ 17.07 M" in neraf-reference.md §1.5
+  EXPECT_EQ(count_parameters(*net), expected);
+  EXPECT_EQ(net->out_features(), 1024);
+}
+
+TEST(ResNet3d, PaperNamesMatchReferenceLayout) {
+  ResNet3d net(resnet3d_paper_options());
+  const auto params = net->named_parameters();
+  for (const std::string name :
+       {"conv1.weight", "bn1.weight", "bn1.bias", "layer1.0.conv1.weight", "layer1.0.conv3.weight",
+        "layer1.0.downsample.0.weight", "layer1.0.downsample.1.weight", "layer2.3.bn3.bias",
+        "layer3.0.downsample.0.weight", "layer3.5.conv2.weight"}) {
+    EXPECT_TRUE(params.contains(name)) << name;
+  }
+  EXPECT_FALSE(params.contains("layer4.0.conv1.weight"));
+  EXPECT_FALSE(params.contains("layer1.1.downsample.0.weight"));
+  EXPECT_TRUE(net->named_buffers().contains("bn1.running_mean"));
+  EXPECT_EQ(params["conv1.weight"].sizes(), (std::vector<int64_t>{64, 7, 5, 5, 5}));
+  EXPECT_EQ(params["layer2.0.conv2.weight"].sizes(), (std::vector<int64_t>{128, 128, 3, 3, 3}));
+}
+
+TEST(ResNet3d, PaperInitIsXavierNormalAndUnitBn) {
+  torch::manual_seed(0);
+  ResNet3d net(resnet3d_paper_options());
+  const auto params = net->named_parameters();
+  // conv1: fan_in = 7·125, fan_out = 64·125 → std = √(2/(fan_in + fan_out)).
+  const double want = std::sqrt(2.0 / (7 * 125 + 64 * 125));
+  EXPECT_NEAR(params["conv1.weight"].std().item<double>(), want, 0.03 * want);
+  // layer3.1.conv2: 256→256, k3: fan = 256·27 each.
+  const double want3 = std::sqrt(2.0 / (2 * 256 * 27));
+  EXPECT_NEAR(params["layer3.1.conv2.weight"].std().item<double>(), want3, 0.02 * want3);
+  EXPECT_NEAR(params["layer3.1.conv2.weight"].mean().item<double>(), 0.0, 0.01 * want3);
+  EXPECT_TRUE(torch::equal(params["layer2.1.bn2.weight"], torch::ones({128})));
+  EXPECT_TRUE(torch::equal(params["layer2.1.bn2.bias"], torch::zeros({128})));
+}
+
+TEST(ResNet3d, PaperForwardAt32AndGradient) {
+  torch::manual_seed(1);
+  ResNet3d net(resnet3d_paper_options());
+  auto x = torch::rand({1, 7, 32, 32, 32}, torch::requires_grad());
+  const auto fm = net->feature_map(x);
+  EXPECT_EQ(fm.sizes(), (std::vector<int64_t>{1, 1024, 2, 2, 2}));  // 32→16→8→8→4→2
+  const auto y = net->forward(x);
+  ASSERT_EQ(y.sizes(), (std::vector<int64_t>{1, 1024}));
+  EXPECT_TRUE(torch::allclose(y, fm.mean({2, 3, 4})));
+  EXPECT_GE(y.min().item<float>(), 0.0f);  // ReLU before the pool
+  y.sum().backward();
+  EXPECT_GT(x.grad().abs().sum().item<float>(), 0.0f);
+}
+
+TEST(ResNet3d, CpuVariantShapeAndSize) {
+  torch::manual_seed(2);
+  ResNet3d net(resnet3d_cpu_options());
+  EXPECT_EQ(net->out_features(), 256);
+  // Basic blocks: stem 7·32·125 + bn; layer1 32→64 (two 3³ convs + 1×1 downsample), layer2 64→128,
+  // layer3 128→256, each with stride 2 after the first.
+  auto bn = [](int64_t c) { return 2 * c; };
+  int64_t expected = 7 * 32 * 125 + bn(32);
+  int64_t in = 32;
+  for (int64_t p : {64, 128, 256}) {
+    expected += in * p * 27 + bn(p) + p * p * 27 + bn(p) + in * p + bn(p);
+    in = p;
+  }
+  EXPECT_EQ(count_parameters(*net), expected);
+  const auto y = net->forward(torch::rand({1, 7, 32, 32, 32}));
+  EXPECT_EQ(y.sizes(), (std::vector<int64_t>{1, 256}));
+}
+
+TEST(ResNet3d, EvalUsesRunningStatistics) {
+  torch::manual_seed(3);
+  ResNet3d net(resnet3d_cpu_options());
+  const auto x = torch::rand({1, 7, 32, 32, 32});
+  const auto train_out = net->forward(x);
+  net->eval();
+  const auto eval_out = net->forward(x);
+  // After a single momentum-0.1 update the running stats differ from the batch stats.
+  EXPECT_FALSE(torch::allclose(train_out, eval_out));
+  EXPECT_TRUE(torch::equal(eval_out, net->forward(x)));  // eval is deterministic, no state change
+}
+
+TEST(ResNet3d, RejectsBadInput) {
+  ResNet3d net(resnet3d_cpu_options());
+  EXPECT_THROW(net->forward(torch::rand({1, 6, 32, 32, 32})), std::exception);
+  ResNet3dOptions bad = resnet3d_cpu_options();
+  bad.planes = {64, 128};
+  EXPECT_THROW(ResNet3d{bad}, std::exception);
+}
+
+}  // namespace
+}  // namespace neraf::acoustic

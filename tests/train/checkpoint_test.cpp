@@ -1,0 +1,202 @@
+#include "neraf/train/checkpoint.h"
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "neraf/train/trainer.h"
+#include "neraf/util/error.h"
+#include "synthetic_scene.h"
+
+namespace fs = std::filesystem;
+using namespace neraf::train;
+
+namespace {
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    path = fs::temp_directory_path() /
+           ("neraf_ckpt_test_" + std::to_string(::getpid()) + "_" +
+            std::to_string(reinterpret_cast<uintptr_t>(this)));
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  std::string file(const std::string& name) const { return (path / name).string(); }
+};
+
+std::vector<torch::Tensor> snapshot(Trainer& t) {
+  std::vector<torch::Tensor> out;
+  for (const auto& p : t.vision()->model()->parameters()) out.push_back(p.detach().clone());
+  return out;
+}
+
+bool same(const std::vector<torch::Tensor>& a, const std::vector<torch::Tensor>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (!torch::equal(a[i], b[i])) return false;
+  return true;
+}
+
+}  // namespace
+
+TEST(Checkpoint, Names) {
+  EXPECT_EQ(fs::path(checkpoint_path("run", 1000)).filename().string(), "step-000001000.pt");
+  EXPECT_EQ(checkpoint_step_from_name("run/checkpoints/step-000001000.pt"), 1000);
+  EXPECT_EQ(checkpoint_step_from_name("run/checkpoints/step-1000.pt"), -1);
+  EXPECT_EQ(checkpoint_step_from_name("step-000001000.pt.tmp-12"), -1);
+  TempDir d;
+  EXPECT_FALSE(latest_checkpoint(d.path.string()).has_value());
+  fs::create_directories(checkpoint_dir(d.path.string()));
+  for (int64_t s : {5, 120, 40}) std::ofstream(checkpoint_path(d.path.string(), s)) << "x";
+  std::ofstream(checkpoint_dir(d.path.string()) + "/step-000000999.pt.tmp-1") << "x";
+  EXPECT_EQ(latest_checkpoint(d.path.string()).value(), checkpoint_path(d.path.string(), 120));
+}
+
+TEST(Checkpoint, SaveLoadRoundTripAndExactResume) {
+  const auto images = testing::make_image_set();
+  const TrainConfig cfg = testing::tiny_train_config();
+  TempDir d;
+
+  // Uninterrupted: 6 steps.
+  auto a = make_trainer(cfg, &images, torch::kCPU);
+  for (int i = 0; i < 6; ++i) a->step();
+
+  // Interrupted after 3 steps, reloaded into a fresh trainer, 3 more steps.
+  auto b = make_trainer(cfg, &images, torch::kCPU);
+  for (int i = 0; i < 3; ++i) b->step();
+  b->save_checkpoint(d.file("b.pt"));
+  auto c = make_trainer(cfg, &images, torch::kCPU);
+  EXPECT_FALSE(same(snapshot(*b), snapshot(*c)));
+  c->load_checkpoint(d.file("b.pt"));
+  EXPECT_EQ(c->completed_steps(), 3);
+  EXPECT_TRUE(same(snapshot(*b), snapshot(*c)));  // round trip equal
+  EXPECT_EQ(c->vision()->steps_since_update(), b->vision()->steps_since_update());
+  for (int i = 0; i < 3; ++i) c->step();
+  // Adam moments, RNG stream and the proposal schedule all resumed: bit-identical.
+  EXPECT_TRUE(same(snapshot(*a), snapshot(*c)));
+}
+
+TEST(Checkpoint, CorruptedOrTruncatedFileIsAClearError) {
+  const auto images = testing::make_image_set();
+  const TrainConfig cfg = testing::tiny_train_config();
+  TempDir d;
+  auto t = make_trainer(cfg, &images, torch::kCPU);
+  t->step();
+  t->save_checkpoint(d.file("good.pt"));
+  // Truncated copy.
+  {
+    std::ifstream in(d.file("good.pt"), std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(d.file("trunc.pt"), std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+    std::string flipped = bytes;
+    for (size_t i = bytes.size() / 3; i < bytes.size() / 3 + 64; ++i) flipped[i] ^= 0x5a;
+    std::ofstream(d.file("flipped.pt"), std::ios::binary) << flipped;
+  }
+  std::ofstream(d.file("garbage.pt")) << "this is not a checkpoint";
+  for (const char* name : {"trunc.pt", "garbage.pt", "missing.pt"}) {
+    auto u = make_trainer(cfg, &images, torch::kCPU);
+    try {
+      u->load_checkpoint(d.file(name));
+      FAIL() << name;
+    } catch (const neraf::Error& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+  // Bit flips inside the zip: either detected (CRC) as a neraf::Error, never a crash.
+  auto u = make_trainer(cfg, &images, torch::kCPU);
+  try {
+    u->load_checkpoint(d.file("flipped.pt"));
+  } catch (const neraf::Error&) {
+  }
+}
+
+TEST(Checkpoint, AnotherPresetOrConfigIsRefused) {
+  const auto images = testing::make_image_set();
+  TrainConfig cfg = testing::tiny_train_config();
+  TempDir d;
+  auto t = make_trainer(cfg, &images, torch::kCPU);
+  t->save_checkpoint(d.file("c.pt"));
+
+  TrainConfig other = cfg;
+  other.preset = "paper";
+  auto u = make_trainer(other, &images, torch::kCPU);
+  try {
+    u->load_checkpoint(d.file("c.pt"));
+    FAIL();
+  } catch (const neraf::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--preset cpu"), std::string::npos) << e.what();
+  }
+  TrainConfig bigger = cfg;
+  bigger.model.field.hidden_dim = 32;
+  auto v = make_trainer(bigger, &images, torch::kCPU);
+  try {
+    v->load_checkpoint(d.file("c.pt"));
+    FAIL();
+  } catch (const neraf::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("model.field.hidden_dim"), std::string::npos) << e.what();
+  }
+  // Run length and precision may differ.
+  TrainConfig longer = cfg;
+  longer.steps = 99;
+  longer.model.precision = neraf::nerf::Precision::bf16;
+  auto w = make_trainer(longer, &images, torch::kCPU);
+  EXPECT_NO_THROW(w->load_checkpoint(d.file("c.pt")));
+  // Same config but a dataset with another number of training images: shape mismatch.
+  const auto three = testing::make_image_set(3);
+  auto x = make_trainer(cfg, &three, torch::kCPU);
+  EXPECT_THROW(x->load_checkpoint(d.file("c.pt")), neraf::Error);
+}
+
+TEST(Trainer, SameSeedSameNumbersAndGroups) {
+  const auto images = testing::make_image_set();
+  const TrainConfig cfg = testing::tiny_train_config();
+  auto a = make_trainer(cfg, &images, torch::kCPU);
+  auto b = make_trainer(cfg, &images, torch::kCPU);
+  for (int i = 0; i < 3; ++i) {
+    const StepResult ra = a->step(), rb = b->step();
+    EXPECT_EQ(ra.loss, rb.loss);
+    EXPECT_EQ(ra.step, i + 1);
+    EXPECT_TRUE(ra.losses.count("rgb_loss") && ra.losses.count("interlevel_loss") &&
+                ra.losses.count("distortion_loss") && ra.losses.count("camera_opt_regularizer"));
+    EXPECT_TRUE(ra.metrics.count("psnr"));
+    EXPECT_EQ(ra.rays, cfg.rays_per_batch);
+  }
+  EXPECT_TRUE(same(snapshot(*a), snapshot(*b)));
+  EXPECT_NEAR(a->group_lr("fields"), learning_rate(cfg.fields, 3), 1e-15);
+  EXPECT_NEAR(a->group_lr("camera_opt"), learning_rate(cfg.camera_opt, 3), 1e-15);
+  TrainConfig other = cfg;
+  other.seed = 7;
+  auto c = make_trainer(other, &images, torch::kCPU);
+  c->step();
+  EXPECT_FALSE(same(snapshot(*a), snapshot(*c)));
+}
+
+TEST(Trainer, AudioModalityIsNotAvailableYet) {
+  const auto images = testing::make_image_set();
+  TrainConfig cfg = testing::tiny_train_config();
+  cfg.modality = Modality::joint;
+  EXPECT_THROW(make_trainer(cfg, &images, torch::kCPU), neraf::Error);
+}
+
+TEST(TrainConfig, JsonRoundTrip) {
+  for (const char* name : {"cpu", "paper"}) {
+    TrainConfig c = train_preset(name);
+    c.seed = 1234;
+    const auto j = to_json(c);
+    const TrainConfig back = train_config_from_json(j, "test");
+    EXPECT_EQ(to_json(back), j);
+    EXPECT_EQ(j["model"]["field"]["grid"]["log2_hashmap_size"],
+              std::string(name) == "paper" ? 19 : 17);
+  }
+  EXPECT_THROW(train_config_from_json(nlohmann::json::parse(R"({"preset": "gpu"})"), "x"),
+               neraf::Error);
+  EXPECT_THROW(train_config_from_json(nlohmann::json::parse(R"({"stepz": 3})"), "x"), neraf::Error);
+}

@@ -1,0 +1,48 @@
+#include "neraf/train/lr_schedule.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace neraf::train;
+
+TEST(LrSchedule, NerfactoFieldsDecay) {
+  ScheduleConfig s;  // 1e-2 → 1e-4 over 200k steps
+  EXPECT_DOUBLE_EQ(learning_rate(s, 0), 1e-2);
+  EXPECT_NEAR(learning_rate(s, 100000), 1e-3, 1e-15);
+  EXPECT_NEAR(learning_rate(s, 200000), 1e-4, 1e-16);
+  EXPECT_NEAR(learning_rate(s, 500000), 1e-4, 1e-16);  // flat after max_steps
+  // nerfstudio's note: at 30k steps ≈ 5.0e-3.
+  EXPECT_NEAR(learning_rate(s, 30000), 1e-2 * std::pow(10.0, -0.3), 1e-12);
+  EXPECT_NEAR(learning_rate(s, 30000), 5.0119e-3, 1e-6);
+}
+
+TEST(LrSchedule, CameraOptDecay) {
+  ScheduleConfig s{1e-3, 1e-4, 5000};
+  EXPECT_DOUBLE_EQ(learning_rate(s, 0), 1e-3);
+  EXPECT_NEAR(learning_rate(s, 2500), std::sqrt(1e-7), 1e-15);
+  EXPECT_NEAR(learning_rate(s, 5000), 1e-4, 1e-16);
+  EXPECT_NEAR(learning_rate(s, 10000), 1e-4, 1e-16);
+}
+
+TEST(LrSchedule, WarmupRamps) {
+  ScheduleConfig s{1e-4, 1e-8, 1002000, 2000};
+  EXPECT_DOUBLE_EQ(learning_rate(s, 0), 1e-8);
+  EXPECT_NEAR(learning_rate(s, 1000), 1e-8 + (1e-4 - 1e-8) * 0.5, 1e-18);
+  EXPECT_DOUBLE_EQ(learning_rate(s, 2000), 1e-4);
+  s.warmup_ramp = "sine";
+  EXPECT_NEAR(learning_rate(s, 1000), 1e-8 + (1e-4 - 1e-8) * std::sin(M_PI / 4), 1e-18);
+  // After the warm-up: log-linear over the remaining 1,000,000 steps.
+  EXPECT_NEAR(learning_rate(s, 502000), std::sqrt(1e-4 * 1e-8), 1e-15);
+}
+
+TEST(LrSchedule, CpuPresetDecaysOverTheRun) {
+  const TrainConfig c = train_preset("cpu");
+  EXPECT_DOUBLE_EQ(learning_rate(c.fields, 0), c.fields.lr);
+  EXPECT_NEAR(learning_rate(c.fields, c.steps), c.fields.lr_final, 1e-15);
+  const TrainConfig p = train_preset("paper");
+  EXPECT_EQ(p.fields.max_steps, 200000);
+  EXPECT_DOUBLE_EQ(p.fields.lr_final, 1e-4);
+  EXPECT_DOUBLE_EQ(p.camera_opt.lr, 1e-3);
+  EXPECT_DOUBLE_EQ(p.fields.eps, 1e-15);
+}

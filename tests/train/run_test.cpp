@@ -1,0 +1,131 @@
+// The run folder end to end on a tiny dataset written in the real nerfstudio layout.
+#include "neraf/train/run.h"
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "neraf/io/json_file.h"
+#include "neraf/train/checkpoint.h"
+#include "neraf/train/evaluation.h"
+#include "neraf/train/image_output.h"
+#include "neraf/util/error.h"
+#include "synthetic_scene.h"
+
+namespace fs = std::filesystem;
+using namespace neraf::train;
+
+namespace {
+
+struct TempDir {
+  fs::path path;
+  explicit TempDir(const std::string& tag) {
+    path = fs::temp_directory_path() / ("neraf_run_test_" + tag + "_" + std::to_string(::getpid()));
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+};
+
+// transforms.json + PNGs for the synthetic scene (train_/eval_ file names).
+void write_dataset(const fs::path& dir, const neraf::data::ImageSet& set) {
+  nlohmann::json frames = nlohmann::json::array();
+  auto add = [&](const neraf::data::ImageSplit& s) {
+    for (int64_t i = 0; i < s.size(); ++i) {
+      const std::string file = "images/" + s.files[static_cast<size_t>(i)];
+      write_png((dir / file).string(), s.images[i]);
+      nlohmann::json m = nlohmann::json::array();
+      for (int r = 0; r < 3; ++r) {
+        nlohmann::json row = nlohmann::json::array();
+        for (int c = 0; c < 4; ++c) row.push_back(s.camera_to_world[i][r][c].item<double>());
+        m.push_back(row);
+      }
+      m.push_back({0.0, 0.0, 0.0, 1.0});
+      frames.push_back({{"file_path", file}, {"transform_matrix", m}});
+    }
+  };
+  add(set.train);
+  add(set.eval);
+  const auto& k = set.train.intrinsics[0];
+  const nlohmann::json t = {{"camera_model", "OPENCV"}, {"fl_x", k.fx}, {"fl_y", k.fy},
+                            {"cx", k.cx},  {"cy", k.cy},  {"w", k.width}, {"h", k.height},
+                            {"frames", frames}};
+  neraf::io::write_json_atomically((dir / "transforms.json").string(), t);
+}
+
+}  // namespace
+
+TEST(Run, TrainResumeRefuseAndLoad) {
+  TempDir tmp("a");
+  const fs::path data = tmp.path / "data", run = tmp.path / "run";
+  write_dataset(data, testing::make_image_set(3));
+  TrainConfig cfg = testing::tiny_train_config();
+  cfg.steps = 4;
+  cfg.save_every = 2;
+  TrainRunOptions o;
+  o.data_dir = data.string();
+  o.run_dir = run.string();
+  o.progress = false;
+  const TrainRunSummary s = run_training(cfg, o);
+  EXPECT_EQ(s.end_step, 4);
+  EXPECT_TRUE(fs::exists(run / "config.json"));
+  EXPECT_TRUE(fs::exists(run / "data.json"));
+  EXPECT_TRUE(fs::exists(checkpoint_path(run.string(), 2)));
+  EXPECT_TRUE(fs::exists(checkpoint_path(run.string(), 4)));
+
+  // A non-empty run folder without --resume/--force is refused.
+  EXPECT_THROW(run_training(cfg, o), neraf::Error);
+
+  // Resume to 6 steps.
+  TrainRunOptions r = o;
+  r.resume = true;
+  r.steps = 6;
+  const TrainRunSummary s2 = run_training(cfg, r);
+  EXPECT_EQ(s2.start_step, 4);
+  EXPECT_EQ(s2.end_step, 6);
+  EXPECT_EQ(neraf::io::read_json((run / "config.json").string())["steps"], 6);
+
+  // Interrupt flag: stops after one step with a checkpoint.
+  std::atomic<bool> stop{true};
+  r.steps = 20;
+  r.stop = &stop;
+  const TrainRunSummary s3 = run_training(cfg, r);
+  EXPECT_TRUE(s3.interrupted);
+  EXPECT_EQ(s3.end_step, 7);
+  EXPECT_TRUE(fs::exists(checkpoint_path(run.string(), 7)));
+
+  // Load for rendering / evaluation.
+  LoadedRun lr = load_run(run.string());
+  EXPECT_EQ(lr.step, 7);
+  EXPECT_FALSE(lr.model->is_training());
+  EXPECT_EQ(lr.manifest["num_eval"], 1);
+  EXPECT_EQ(manifest_eval_poses(lr.manifest).sizes(), (std::vector<int64_t>{1, 3, 4}));
+  const auto images = neraf::data::load_transforms_json(data.string());
+  VisionEvalOptions eo;
+  eo.progress = false;
+  eo.image_dir = (run / "eval").string();
+  const VisionEval e = evaluate_vision(lr.model, images.eval, eo);
+  EXPECT_EQ(e.n_views, 1);
+  EXPECT_TRUE(std::isfinite(e.psnr));
+  EXPECT_GT(e.ssim, -1.0);
+  EXPECT_TRUE(fs::exists(run / "eval" / "eval_00000.png"));
+
+  // --force starts over.
+  TrainRunOptions f = o;
+  f.force = true;
+  const TrainRunSummary s4 = run_training(cfg, f);
+  EXPECT_EQ(s4.start_step, 0);
+  EXPECT_FALSE(fs::exists(checkpoint_path(run.string(), 7)));
+}
+
+TEST(Run, LoadRunErrors) {
+  TempDir tmp("b");
+  EXPECT_THROW(load_run((tmp.path / "nope").string()), neraf::Error);
+  EXPECT_THROW(load_run(tmp.path.string()), neraf::Error);  // no config.json
+}
