@@ -18,7 +18,7 @@ TEST(ResNet3dSlow, PaperAt128MatchesAvgPool8) {
   ASSERT_EQ(fm.sizes(), (std::vector<int64_t>{1, 1024, 8, 8, 8}));
   // The reference's AvgPool3d(kernel 8, stride 1) equals our adaptive (global) average here.
   const auto ref = torch::avg_pool3d(fm, 8, 1).flatten(1);
-  const auto y = torch::adaptive_avg_pool3d(fm, 1).flatten(1);
+  const auto y = torch::adaptive_avg_pool3d(fm, {1, 1, 1}).flatten(1);
   EXPECT_TRUE(torch::allclose(ref, y, 1e-5, 1e-6));
   EXPECT_EQ(y.sizes(), (std::vector<int64_t>{1, 1024}));
 }

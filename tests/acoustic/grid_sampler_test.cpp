@@ -160,10 +160,11 @@ TEST(GridSampler, RoundRobinPointerWraps) {
       EXPECT_NEAR(a[n].item<float>(), want, 1e-6) << "call " << call << " cell " << n;
     }
   }
-  // Call 3 wrote 48..63 and 0..7; call 4 started at 8.
+  // Call 3 wrote 48..63 and 0..7; call 4 wrote 8..31.
   EXPECT_EQ(writer[63], 3);
-  EXPECT_EQ(writer[0], 4);
-  EXPECT_EQ(writer[7], 4);
+  EXPECT_EQ(writer[0], 3);
+  EXPECT_EQ(writer[7], 3);
+  EXPECT_EQ(writer[8], 4);
   EXPECT_EQ(writer[31], 4);
   EXPECT_EQ(writer[32], 2);
 }

@@ -265,6 +265,59 @@ TEST(HashGridEncode, NoPositionGradientUnlessRequested) {
   EXPECT_NEAR(op.grad_table.sum().item<double>(), 100.0 * 4 * 2, 1e-3);
 }
 
+TEST(HashGridEncode, OutOfRangeInputsFollowTcnnWrapAround) {
+  // Not used by Nerfacto (contracted inputs lie in [0,1]), but the semantics must not depend on
+  // the code path: uint32 wrap-around, then modulo the level size.
+  const HashGridLayout layout = HashGridLayout::make({6, 2, 12, 8, 200});
+  torch::manual_seed(14);
+  const int64_t n = 1000;
+  const torch::Tensor x = (torch::rand({n, 3}) * 5 - 2).contiguous();
+  const torch::Tensor table = torch::randn({layout.total_entries, 2});
+  const torch::Tensor upstream = torch::randn({n, layout.output_dim()});
+  const OpResult op = run(false, x, table, upstream, layout, true);
+  const OpResult ref = run(true, x, table, upstream, layout, true);
+  EXPECT_LT(max_rel_err(op.out, ref.out), 2e-6);
+  EXPECT_LT(max_rel_err(op.grad_table, ref.grad_table), 2e-6);
+  EXPECT_LT(max_rel_err(op.grad_x, ref.grad_x), 2e-5);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The raw kernels: the AVX-512 path against the portable scalar path
+
+void expect_paths_identical(const HashGridConfig& cfg, const torch::Tensor& x, int threads) {
+  const HashGridLayout layout = HashGridLayout::make(cfg);
+  const int64_t n = x.size(0);
+  torch::manual_seed(15);
+  const torch::Tensor table = torch::randn({layout.total_entries, layout.features()});
+  const torch::Tensor upstream = torch::randn({n, layout.output_dim()});
+  torch::Tensor out[2], grad_table[2], grad_x[2];
+  const HashGridPath paths[2] = {HashGridPath::kBest, HashGridPath::kScalar};
+  for (int p = 0; p < 2; ++p) {
+    out[p] = torch::empty({n, layout.output_dim()});
+    grad_table[p] = torch::zeros_like(table);
+    grad_x[p] = torch::empty({n, 3});
+    hash_grid_forward_cpu<float>(x.data_ptr<float>(), n, table.data_ptr<float>(), layout,
+                                 out[p].data_ptr<float>(), threads, paths[p]);
+    hash_grid_backward_cpu<float>(x.data_ptr<float>(), n, table.data_ptr<float>(),
+                                  upstream.data_ptr<float>(), layout,
+                                  grad_table[p].data_ptr<float>(), grad_x[p].data_ptr<float>(),
+                                  threads, paths[p]);
+  }
+  EXPECT_TRUE(torch::equal(out[0], out[1]));
+  EXPECT_TRUE(torch::equal(grad_table[0], grad_table[1]));
+  EXPECT_TRUE(torch::equal(grad_x[0], grad_x[1]));
+}
+
+TEST(HashGridKernel, SimdAndScalarPathsAreBitIdentical) {
+  if (!hash_grid_has_simd()) GTEST_SKIP() << "this build has no AVX-512 path";
+  // 10007 points: not a multiple of the 16-point blocks, so the scalar tails run too.
+  expect_paths_identical({}, test_points(10007, 16), 2);
+  expect_paths_identical({5, 2, 17, 16, 256}, test_points(10007, 17), 1);
+  // Inputs far outside [0,1] take the per-block scalar fallback of the dense levels.
+  torch::manual_seed(18);
+  expect_paths_identical({6, 2, 12, 8, 200}, (torch::rand({5003, 3}) * 40 - 20).contiguous(), 2);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Finite differences (double precision, tiny grid with dense and hashed levels)
 

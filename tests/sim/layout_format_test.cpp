@@ -23,7 +23,8 @@ namespace {
 using nlohmann::json;
 
 std::filesystem::path temp_dir(const std::string& name) {
-  auto d = std::filesystem::temp_directory_path() / ("neraf_" + name + "_" + std::to_string(::getpid()));
+  auto d =
+      std::filesystem::temp_directory_path() / ("neraf_" + name + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(d);
   std::filesystem::create_directories(d);
   return d;
@@ -72,7 +73,7 @@ TEST(LayoutFormat, SoundSpacesNamesAndSplit) {
   std::set<std::string> all;
   for (const auto& e : split["train"]) all.insert(e.get<std::string>());
   for (const auto& e : split["test"]) all.insert(e.get<std::string>());
-  EXPECT_EQ(all.size(), 1000u);  // disjoint and complete
+  EXPECT_EQ(all.size(), 1000u);                   // disjoint and complete
   EXPECT_EQ(soundspaces_split(names, 5), split);  // seeded
   EXPECT_NE(soundspaces_split(names, 6)["test"], split["test"]);
   // The test entries are spread over the whole list, not a block.
@@ -220,7 +221,8 @@ TEST(LayoutFormat, PngRoundTrip) {
 TEST(LayoutFormat, WavIsReadableAndHasNoTimestamp) {
   const auto dir = temp_dir("wav");
   const std::string path = (dir / "x" / "rir.wav").string();
-  const std::vector<std::vector<float>> ch = {{0.5f, -0.25f, 0.125f, 0.f}, {0.f, 1.5f, -2.f, 1e-7f}};
+  const std::vector<std::vector<float>> ch = {{0.5f, -0.25f, 0.125f, 0.f},
+                                              {0.f, 1.5f, -2.f, 1e-7f}};
   write_wav_float(path, ch, 44100);
   const auto audio = io::read_audio(path);
   EXPECT_EQ(audio.sample_rate, 44100);

@@ -72,7 +72,8 @@ SynthOptions options(const fs::path& out, uint64_t seed, const std::string& layo
 std::map<std::string, std::string> tree(const fs::path& dir) {
   std::map<std::string, std::string> out;
   for (const auto& e : fs::recursive_directory_iterator(dir)) {
-    if (e.is_regular_file()) out[fs::relative(e.path(), dir).string()] = io::read_text_file(e.path().string());
+    if (e.is_regular_file())
+      out[fs::relative(e.path(), dir).string()] = io::read_text_file(e.path().string());
   }
   return out;
 }
@@ -114,15 +115,17 @@ TEST(LayoutSynth, SoundSpacesFilesNamesAndFormats) {
   EXPECT_EQ(t["w"], 24);
   EXPECT_EQ(t["h"], 16);
   ASSERT_EQ(t["frames"].size(), 6u);
-  const std::vector<std::string> want = {"images/train_frame_00000.png", "images/train_frame_00001.png",
-                                         "images/train_frame_00002.png", "images/train_frame_00003.png",
-                                         "images/eval_frame_00000.png",  "images/eval_frame_00001.png"};
+  const std::vector<std::string> want = {
+      "images/train_frame_00000.png", "images/train_frame_00001.png",
+      "images/train_frame_00002.png", "images/train_frame_00003.png",
+      "images/eval_frame_00000.png",  "images/eval_frame_00001.png"};
   for (size_t i = 0; i < 6; ++i) {
     EXPECT_EQ(t["frames"][i]["file_path"], want[i]);
     expect_png(out / want[i], 24, 16);
     const auto& m = t["frames"][i]["transform_matrix"];
     // The camera sits inside the room.
-    EXPECT_TRUE(inside_room(scene, {m[0][3].get<double>(), m[1][3].get<double>(), m[2][3].get<double>()}));
+    EXPECT_TRUE(
+        inside_room(scene, {m[0][3].get<double>(), m[1][3].get<double>(), m[2][3].get<double>()}));
   }
 
   // points.txt: mics then the source; NeRAF's [x, z, −y] gives our coordinates back.
@@ -152,7 +155,8 @@ TEST(LayoutSynth, SoundSpacesFilesNamesAndFormats) {
   EXPECT_EQ(split["test"].size(), 3u);  // round(0.1 · 32)
   for (int h : {0, 90, 180, 270}) {
     for (int r = 0; r < 8; ++r) {
-      const std::string name = std::to_string(h) + "/" + std::to_string(r) + "_8";  // source = point 8
+      const std::string name =
+          std::to_string(h) + "/" + std::to_string(r) + "_8";  // source = point 8
       EXPECT_EQ(entries.count(name), 1u) << name;
       EXPECT_TRUE(fs::exists(out / "binaural_rirs" / (name + ".wav"))) << name;
     }
@@ -163,7 +167,8 @@ TEST(LayoutSynth, SoundSpacesFilesNamesAndFormats) {
   EXPECT_EQ(audio.num_frames(), 4410);
   double peak = 0, energy_l = 0, energy_r = 0;
   for (size_t i = 0; i < 4410; ++i) {
-    peak = std::max({peak, double(std::abs(audio.channels[0][i])), double(std::abs(audio.channels[1][i]))});
+    peak = std::max(
+        {peak, double(std::abs(audio.channels[0][i])), double(std::abs(audio.channels[1][i]))});
     energy_l += audio.channels[0][i] * audio.channels[0][i];
     energy_r += audio.channels[1][i] * audio.channels[1][i];
   }
@@ -214,9 +219,11 @@ TEST(LayoutSynth, RafFilesNamesAndFormats) {
     EXPECT_NEAR(std::stod(rx[2]), mics[r].z, 1e-6);
     const auto tx = split_line(io::read_text_file((dir / "tx_pos.txt").string()), ',');
     ASSERT_EQ(tx.size(), 7u);
-    const double qx = std::stod(tx[0]), qy = std::stod(tx[1]), qz = std::stod(tx[2]), qw = std::stod(tx[3]);
+    const double qx = std::stod(tx[0]), qy = std::stod(tx[1]), qz = std::stod(tx[2]),
+                 qw = std::stod(tx[3]);
     // scipy as_euler('yxz')[0]: atan2(−R[2][0], R[2][2]) (see layout_format_test).
-    const double yaw = std::atan2(-2 * (qx * qz - qw * qy), 1 - 2 * (qx * qx + qy * qy)) * 180 / M_PI;
+    const double yaw =
+        std::atan2(-2 * (qx * qz - qw * qy), 1 - 2 * (qx * qx + qy * qy)) * 180 / M_PI;
     EXPECT_NEAR(yaw, scene.sources[s].yaw_deg, 1e-6);
     EXPECT_NEAR(std::stod(tx[4]), scene.sources[s].position.x, 1e-6);
     EXPECT_NEAR(std::stod(tx[6]), scene.sources[s].position.z, 1e-6);
@@ -271,7 +278,8 @@ TEST(LayoutSynth, RefusesANonEmptyFolderUnlessForced) {
     synthesize(scene, options(out, 1, "raf"));
     FAIL() << "expected an error";
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()).rfind(out.string() + ": the folder is not empty", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).rfind(out.string() + ": the folder is not empty", 0), 0u)
+        << e.what();
     EXPECT_NE(std::string(e.what()).find("--force"), std::string::npos);
   }
   EXPECT_FALSE(fs::exists(out / "data"));

@@ -43,7 +43,9 @@ CameraView camera_facing_x1(const Scene& s) {
   return {geometry::look_at({2, 1.5, 2}, {4, 1.5, 2}), camera_intrinsics(s.cameras)};
 }
 
-const uint8_t* pixel(const RgbImage& img, int x, int y) { return &img.pixels[(size_t(y) * img.width + x) * 3]; }
+const uint8_t* pixel(const RgbImage& img, int x, int y) {
+  return &img.pixels[(size_t(y) * img.width + x) * 3];
+}
 
 TEST(RenderImage, WallPixelIsLambertianUnderThePointLight) {
   const Scene s = wall_scene();
@@ -54,9 +56,9 @@ TEST(RenderImage, WallPixelIsLambertianUnderThePointLight) {
   ASSERT_EQ(img.pixels.size(), 33u * 33u * 3u);
   const double f = view.intrinsics.fx;
   EXPECT_DOUBLE_EQ(f, 16.5);  // (33 / 2) / tan(45°)
-  // Pixel (px, py): camera-frame direction ((px + .5 − 16.5)/f, −(py + .5 − 16.5)/f, −1); the camera
-  // looks along +x with right = +z and up = +y, so the world direction is (1, dy, dx) and the ray
-  // meets the wall x = 4 at (4, 1.5 + 2·dy, 2 + 2·dx), where the normal is (−1, 0, 0).
+  // Pixel (px, py): camera-frame direction ((px + .5 − 16.5)/f, −(py + .5 − 16.5)/f, −1); the
+  // camera looks along +x with right = +z and up = +y, so the world direction is (1, dy, dx) and
+  // the ray meets the wall x = 4 at (4, 1.5 + 2·dy, 2 + 2·dx), where the normal is (−1, 0, 0).
   for (auto [px, py] : {std::pair{16, 16}, std::pair{3, 28}, std::pair{30, 5}, std::pair{10, 12}}) {
     const double dx = (px + 0.5 - 16.5) / f, dy = -(py + 0.5 - 16.5) / f;
     const geometry::Vec3 hit{4, 1.5 + 2 * dy, 2 + 2 * dx};
@@ -65,7 +67,8 @@ TEST(RenderImage, WallPixelIsLambertianUnderThePointLight) {
     const geometry::Vec3 albedo{0.8, 0.5, 0.2};
     for (int c = 0; c < 3; ++c) {
       const double linear = albedo[c] * (0.2 + 0.9 * cos_theta);
-      EXPECT_NEAR(pixel(img, px, py)[c], expected_8bit(linear), 1) << px << "," << py << " channel " << c;
+      EXPECT_NEAR(pixel(img, px, py)[c], expected_8bit(linear), 1)
+          << px << "," << py << " channel " << c;
     }
   }
   // The centre pixel exactly: cos θ = 2 / sqrt(2² + 1.3²).
@@ -137,7 +140,8 @@ TEST(RenderImage, TextureFactors) {
     EXPECT_LE(f, 1.0);
   }
   EXPECT_GT(hi - lo, 0.1);  // it varies
-  EXPECT_NE(texture_factor(noise, 0.31, 0.17, 3), texture_factor(noise, 0.31, 0.17, 4));  // per face
+  EXPECT_NE(texture_factor(noise, 0.31, 0.17, 3),
+            texture_factor(noise, 0.31, 0.17, 4));  // per face
   // Continuous: small steps give small changes.
   EXPECT_NEAR(texture_factor(noise, 0.5, 0.5, 3), texture_factor(noise, 0.5001, 0.5, 3), 1e-3);
 }
@@ -146,7 +150,7 @@ TEST(RenderImage, SrgbEncoding) {
   EXPECT_EQ(to_8bit(linear_to_srgb(0.0)), 0);
   EXPECT_EQ(to_8bit(linear_to_srgb(1.0)), 255);
   EXPECT_EQ(to_8bit(linear_to_srgb(2.0)), 255);
-  EXPECT_EQ(to_8bit(linear_to_srgb(0.21586)), 128);  // sRGB 128 ≈ linear 0.2159
+  EXPECT_EQ(to_8bit(linear_to_srgb(0.21586)), 128);   // sRGB 128 ≈ linear 0.2159
   EXPECT_NEAR(linear_to_srgb(0.002), 0.02584, 1e-6);  // linear segment
 }
 

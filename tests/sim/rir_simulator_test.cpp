@@ -6,6 +6,7 @@
 #include <memory>
 #include <numeric>
 
+#include "neraf/geometry/box.h"
 #include "neraf/util/error.h"
 #include "rir_test_util.h"
 
@@ -346,6 +347,22 @@ TEST(RirSimulator, FurnitureBetweenSourceAndMicOccludesTheDirectPath) {
   EXPECT_EQ(a_aside[0].gain, a_open[0].gain);
   EXPECT_TRUE(blocked.inside_furniture({3, 0.5, 3}));
   EXPECT_FALSE(blocked.inside_furniture({3, 2, 3}));
+}
+
+TEST(RirSimulator, FurnitureYawMatchesTheGeometryBoxConvention) {
+  // The picture renderer uses geometry::YawBox; sound must see the furniture in the same place.
+  Scene s = shoebox({6, 3, 6}, 0.2);
+  s.furniture.push_back({{3, 0.5, 3}, {2.0, 1.0, 0.4}, 35, "wall"});
+  RirSimulator sim(s, 48000, nullptr, mono_dry());
+  const geometry::YawBox box{{3, 0.5, 3}, {1.0, 0.5, 0.2}, geometry::deg_to_rad(35)};
+  int inside = 0;
+  for (int i = 0; i < 60; ++i)
+    for (int j = 0; j < 60; ++j) {
+      const Vec3 p{1.5 + 0.05 * i, 0.5, 1.5 + 0.05 * j};
+      EXPECT_EQ(sim.inside_furniture(p), box.contains(p)) << p.x << " " << p.z;
+      inside += box.contains(p);
+    }
+  EXPECT_GT(inside, 100);
 }
 
 TEST(RirSimulator, OcclusionAppliesToReflectionLegs) {

@@ -1,14 +1,14 @@
 // Scene JSON: errors name the file and the JSON path, defaults, round trips.
-#include <gtest/gtest.h>
+#include "neraf/sim/scene_json.h"
 
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <string>
 
-#include "neraf/sim/scene_json.h"
 #include "neraf/util/error.h"
 
 namespace neraf::sim {
@@ -49,17 +49,24 @@ std::string error_with(const std::function<void(json&)>& edit) {
 TEST(SceneJson, BaseSceneParses) { EXPECT_EQ(error_of(base().dump()), ""); }
 
 TEST(SceneJson, FurnitureSizeErrorNamesThePath) {
-  EXPECT_EQ(error_with([](json& j) { j["furniture"][2]["size"] = {1, -1, 1}; }),
+  EXPECT_EQ(error_with([](json& j) {
+              j["furniture"][2]["size"] = {1, -1, 1};
+            }),
             "scene.json: furniture[2].size: must be three positive numbers");
   EXPECT_EQ(error_with([](json& j) { j["furniture"][2]["size"] = "big"; }),
             "scene.json: furniture[2].size: must be three positive numbers");
-  EXPECT_EQ(error_with([](json& j) { j["furniture"][2]["size"] = {1, 1}; }),
+  EXPECT_EQ(error_with([](json& j) {
+              j["furniture"][2]["size"] = {1, 1};
+            }),
             "scene.json: furniture[2].size: must be three positive numbers");
 }
 
 TEST(SceneJson, TypeErrorsNameThePath) {
-  EXPECT_EQ(error_with([](json& j) { j["size"] = "large"; }), "scene.json: size: must be three positive numbers");
-  EXPECT_EQ(error_with([](json& j) { j["size"] = {4, 0, 5}; }).rfind("scene.json: size: must be three positive numbers", 0),
+  EXPECT_EQ(error_with([](json& j) { j["size"] = "large"; }),
+            "scene.json: size: must be three positive numbers");
+  EXPECT_EQ(error_with([](json& j) {
+              j["size"] = {4, 0, 5};
+            }).rfind("scene.json: size: must be three positive numbers", 0),
             0u);
   EXPECT_EQ(error_with([](json& j) { j["cameras"]["width"] = 12.5; }),
             "scene.json: cameras.width: must be a whole number of pixels in [8, 8192]");
@@ -67,7 +74,9 @@ TEST(SceneJson, TypeErrorsNameThePath) {
             "scene.json: cameras.width: must be a whole number of pixels in [8, 8192]");
   EXPECT_EQ(error_with([](json& j) { j["acoustics"]["rir_length_s"] = -1; }),
             "scene.json: acoustics.rir_length_s: must be a number of seconds in (0, 20]");
-  EXPECT_EQ(error_with([](json& j) { j["furniture"] = json::object(); }).rfind("scene.json: furniture: must be a list", 0),
+  EXPECT_EQ(error_with([](json& j) {
+              j["furniture"] = json::object();
+            }).rfind("scene.json: furniture: must be a list", 0),
             0u);
 }
 
@@ -77,26 +86,32 @@ TEST(SceneJson, UnknownKeysAreNamed) {
   EXPECT_NE(top.find("size"), std::string::npos) << top;  // lists the known keys
 
   const std::string nested = error_with([](json& j) { j["furniture"][1]["colour"] = "red"; });
-  EXPECT_NE(nested.find("scene.json: furniture[1]: unknown key \"colour\""), std::string::npos) << nested;
+  EXPECT_NE(nested.find("scene.json: furniture[1]: unknown key \"colour\""), std::string::npos)
+      << nested;
 
   const std::string mat = error_with([](json& j) { j["materials"]["wood"]["absorb"] = 0.1; });
-  EXPECT_NE(mat.find("scene.json: materials.wood: unknown key \"absorb\""), std::string::npos) << mat;
+  EXPECT_NE(mat.find("scene.json: materials.wood: unknown key \"absorb\""), std::string::npos)
+      << mat;
 
   const std::string two = error_with([](json& j) {
     j["microphones"]["grid"]["spaceing"] = 1;
     j["microphones"]["grid"]["hight"] = 1;
   });
-  EXPECT_NE(two.find("microphones.grid: unknown keys \"hight\", \"spaceing\""), std::string::npos) << two;
+  EXPECT_NE(two.find("microphones.grid: unknown keys \"hight\", \"spaceing\""), std::string::npos)
+      << two;
 }
 
 TEST(SceneJson, AbsorptionMustBeSevenValuesBelowOne) {
-  const std::string one = error_with([](json& j) {
-    j["materials"]["wood"]["absorption"] = {0.1, 0.1, 0.1, 1.0, 0.1, 0.1, 0.1};
-  });
-  EXPECT_EQ(one.rfind("scene.json: materials.wood.absorption: must be 7 numbers in [0, 1)", 0), 0u) << one;
-  const std::string six = error_with([](json& j) { j["materials"]["wood"]["absorption"] = {0.1, 0.1, 0.1, 0.1, 0.1, 0.1}; });
-  EXPECT_EQ(six.rfind("scene.json: materials.wood.absorption: must be 7 numbers in [0, 1)", 0), 0u) << six;
-  const std::string neg = error_with([](json& j) { j["materials"]["wood"]["absorption"] = {-0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1}; });
+  const std::string one = error_with(
+      [](json& j) { j["materials"]["wood"]["absorption"] = {0.1, 0.1, 0.1, 1.0, 0.1, 0.1, 0.1}; });
+  EXPECT_EQ(one.rfind("scene.json: materials.wood.absorption: must be 7 numbers in [0, 1)", 0), 0u)
+      << one;
+  const std::string six = error_with(
+      [](json& j) { j["materials"]["wood"]["absorption"] = {0.1, 0.1, 0.1, 0.1, 0.1, 0.1}; });
+  EXPECT_EQ(six.rfind("scene.json: materials.wood.absorption: must be 7 numbers in [0, 1)", 0), 0u)
+      << six;
+  const std::string neg = error_with(
+      [](json& j) { j["materials"]["wood"]["absorption"] = {-0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1}; });
   EXPECT_EQ(neg.rfind("scene.json: materials.wood.absorption:", 0), 0u) << neg;
 }
 
@@ -108,9 +123,14 @@ TEST(SceneJson, UnknownMaterialNames) {
 }
 
 TEST(SceneJson, TexturesAreChecked) {
-  const std::string k = error_with([](json& j) { j["materials"]["wood"]["texture"] = {{"kind", "plaid"}}; });
-  EXPECT_EQ(k.rfind("scene.json: materials.wood.texture.kind: unknown texture \"plaid\"", 0), 0u) << k;
-  const std::string c = error_with([](json& j) { j["materials"]["wood"]["texture"] = {{"kind", "noise"}, {"contrast", 2}}; });
+  const std::string k = error_with([](json& j) {
+    j["materials"]["wood"]["texture"] = {{"kind", "plaid"}};
+  });
+  EXPECT_EQ(k.rfind("scene.json: materials.wood.texture.kind: unknown texture \"plaid\"", 0), 0u)
+      << k;
+  const std::string c = error_with([](json& j) {
+    j["materials"]["wood"]["texture"] = {{"kind", "noise"}, {"contrast", 2}};
+  });
   EXPECT_EQ(c, "scene.json: materials.wood.texture.contrast: must be a number in [0, 1]");
   // The string shorthand works.
   EXPECT_EQ(error_with([](json& j) { j["materials"]["wood"]["texture"] = "checker"; }), "");
@@ -121,23 +141,39 @@ TEST(SceneJson, BoxesMustStayInsideTheRoom) {
   EXPECT_EQ(e.rfind("scene.json: furniture[1]: the box", 0), 0u) << e;
   EXPECT_NE(e.find("reaches outside the room"), std::string::npos) << e;
   // A 45° yaw widens the footprint: a 1 m cube centred 0.6 m from a wall no longer fits.
-  const std::string yaw = error_with([](json& j) { j["furniture"][0] = {{"center", {0.6, 0.5, 1}}, {"size", {1, 1, 1}}, {"yaw_deg", 45}}; });
+  const std::string yaw = error_with([](json& j) {
+    j["furniture"][0] = {{"center", {0.6, 0.5, 1}}, {"size", {1, 1, 1}}, {"yaw_deg", 45}};
+  });
   EXPECT_EQ(yaw.rfind("scene.json: furniture[0]: the box", 0), 0u) << yaw;
-  EXPECT_EQ(error_with([](json& j) { j["furniture"][0] = {{"center", {0.6, 0.5, 1}}, {"size", {1, 1, 1}}}; }), "");
+  EXPECT_EQ(error_with([](json& j) {
+              j["furniture"][0] = {{"center", {0.6, 0.5, 1}}, {"size", {1, 1, 1}}};
+            }),
+            "");
 }
 
 TEST(SceneJson, SourcesAndMicrophonesMustBeInFreeSpace) {
   const std::string in_box = error_with([](json& j) { j["sources"][0]["position"] = {1, 0.5, 1}; });
-  EXPECT_EQ(in_box.rfind("scene.json: sources[0].position: [1, 0.5, 1] is inside furniture[0]", 0), 0u) << in_box;
-  const std::string outside = error_with([](json& j) { j["sources"].push_back({{"position", {5, 1, 1}}}); });
-  EXPECT_EQ(outside.rfind("scene.json: sources[1].position: [5, 1, 1] is outside the room", 0), 0u) << outside;
+  EXPECT_EQ(in_box.rfind("scene.json: sources[0].position: [1, 0.5, 1] is inside furniture[0]", 0),
+            0u)
+      << in_box;
+  const std::string outside = error_with([](json& j) {
+    j["sources"].push_back({{"position", {5, 1, 1}}});
+  });
+  EXPECT_EQ(outside.rfind("scene.json: sources[1].position: [5, 1, 1] is outside the room", 0), 0u)
+      << outside;
   const std::string dir = error_with([](json& j) { j["sources"][0]["directivity"] = "figure8"; });
   EXPECT_EQ(dir.rfind("scene.json: sources[0].directivity: unknown directivity", 0), 0u) << dir;
 
   const std::string mic = error_with([](json& j) { j["microphones"]["grid"]["height_m"] = 3.5; });
-  EXPECT_EQ(mic.rfind("scene.json: microphones.grid.height_m: must be inside the room height", 0), 0u) << mic;
-  const std::string heading = error_with([](json& j) { j["microphones"]["grid"]["headings_deg"] = {0, 45.5}; });
-  EXPECT_EQ(heading.rfind("scene.json: microphones.grid.headings_deg: must be a non-empty list", 0), 0u) << heading;
+  EXPECT_EQ(mic.rfind("scene.json: microphones.grid.height_m: must be inside the room height", 0),
+            0u)
+      << mic;
+  const std::string heading = error_with([](json& j) {
+    j["microphones"]["grid"]["headings_deg"] = {0, 45.5};
+  });
+  EXPECT_EQ(heading.rfind("scene.json: microphones.grid.headings_deg: must be a non-empty list", 0),
+            0u)
+      << heading;
   const std::string rnd = error_with([](json& j) {
     j["microphones"]["kind"] = "random";
     j["microphones"]["random"]["max_height_m"] = 9;
@@ -148,10 +184,12 @@ TEST(SceneJson, SourcesAndMicrophonesMustBeInFreeSpace) {
     j["furniture"] = {{{"center", {2, 1.0, 2.5}}, {"size", {4, 2, 5}}}};
     j["sources"][0]["position"] = {2, 2.5, 2.5};
   });
-  EXPECT_EQ(covered.rfind("scene.json: microphones.grid: no grid point is in free space", 0), 0u) << covered;
+  EXPECT_EQ(covered.rfind("scene.json: microphones.grid: no grid point is in free space", 0), 0u)
+      << covered;
 
   const std::string light = error_with([](json& j) { j["light"]["position"] = {2, 3.5, 2}; });
-  EXPECT_EQ(light.rfind("scene.json: light.position: [2, 3.5, 2] is outside the room", 0), 0u) << light;
+  EXPECT_EQ(light.rfind("scene.json: light.position: [2, 3.5, 2] is outside the room", 0), 0u)
+      << light;
 }
 
 TEST(SceneJson, DefaultsFillEverything) {
@@ -168,7 +206,8 @@ TEST(SceneJson, DefaultsFillEverything) {
   EXPECT_EQ(s.microphones.kind, "grid");
   EXPECT_EQ(s.cameras.train_count, Cameras{}.train_count);
   // A partly specified material takes the Material{} defaults for the rest.
-  const Scene w = scene_from_json(json::parse(R"({"materials": {"wall": {"albedo": [1, 0, 0]}}})"), "w.json");
+  const Scene w =
+      scene_from_json(json::parse(R"({"materials": {"wall": {"albedo": [1, 0, 0]}}})"), "w.json");
   EXPECT_EQ(w.materials.at("wall").absorption, Material{}.absorption);
   EXPECT_DOUBLE_EQ(w.materials.at("wall").albedo.x, 1.0);
 }
@@ -178,7 +217,8 @@ TEST(SceneJson, RoundTripIsExact) {
   j["name"] = "round trip";
   j["materials"]["wood"]["absorption"] = {0.01, 0.123456789012345, 0.3, 0.4, 0.5, 0.6, 0.7};
   j["materials"]["wood"]["texture"] = {{"kind", "noise"}, {"scale_m", 0.1234}, {"contrast", 0.7}};
-  j["sources"].push_back({{"position", {0.5, 2.0, 4.5}}, {"yaw_deg", 123.25}, {"directivity", "cardioid"}});
+  j["sources"].push_back(
+      {{"position", {0.5, 2.0, 4.5}}, {"yaw_deg", 123.25}, {"directivity", "cardioid"}});
   j["microphones"] = {{"kind", "random"}, {"random", {{"count", 17}, {"headings_deg", {0, 180}}}}};
   j["cameras"] = {{"train_count", 7}, {"width", 33}, {"fov_deg", 75.5}};
   j["light"] = {{"position", {1.1, 2.2, 3.3}}, {"intensity", 0.7}};
@@ -201,7 +241,8 @@ TEST(SceneJson, RoundTripIsExact) {
 }
 
 TEST(SceneJson, LoadSceneNamesTheFile) {
-  const auto dir = std::filesystem::temp_directory_path() / ("neraf_scene_json_" + std::to_string(::getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("neraf_scene_json_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::string bad = (dir / "bad.json").string();
   std::ofstream(bad) << "{\"size\": [1, 2,";

@@ -26,7 +26,8 @@ TEST(ScenePresets, UnknownPresetListsTheKnownOnes) {
     preset_scene("castle");
     FAIL();
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()), "--preset: unknown preset \"castle\"; choose one of demo, shoebox, furnished");
+    EXPECT_EQ(std::string(e.what()),
+              "--preset: unknown preset \"castle\"; choose one of demo, shoebox, furnished");
   }
 }
 
@@ -49,7 +50,8 @@ TEST(ScenePresets, DemoIsSmallEnoughToTrainInMinutes) {
 TEST(ScenePresets, ShoeboxIsEmptyAndUniform) {
   const Scene s = preset_scene("shoebox");
   EXPECT_TRUE(s.furniture.empty());
-  for (const auto& [n, m] : s.materials) EXPECT_EQ(m.absorption, s.materials.at("wall").absorption) << n;
+  for (const auto& [n, m] : s.materials)
+    EXPECT_EQ(m.absorption, s.materials.at("wall").absorption) << n;
   EXPECT_EQ(plan_synthesis(s, "soundspaces", 0).jobs.size(), 80u);
 }
 

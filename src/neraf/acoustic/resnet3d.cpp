@@ -117,7 +117,7 @@ torch::Tensor ResNet3dImpl::feature_map(const torch::Tensor& x) {
 }
 
 torch::Tensor ResNet3dImpl::forward(const torch::Tensor& x) {
-  return torch::adaptive_avg_pool3d(feature_map(x), 1).flatten(1);  // [B, C]
+  return torch::adaptive_avg_pool3d(feature_map(x), {1, 1, 1}).flatten(1);  // [B, C]
 }
 
 }  // namespace neraf::acoustic

@@ -20,7 +20,7 @@ struct SynthArgs {
   std::string scene_file, preset, layout = "soundspaces", out_dir, hrtf;
   uint64_t seed = 0;
   int threads = 0;
-  bool force = false, quiet = false, print_scene = false;
+  bool force = false, quiet = false, print_scene = false, dry_run = false;
 };
 
 std::string preset_list() {
@@ -32,10 +32,23 @@ std::string preset_list() {
 void run_synth(const SynthArgs& a) {
   require(a.scene_file.empty() != a.preset.empty(),
           "synth: give exactly one of --scene FILE.json or --preset NAME (" + preset_list() + ")");
-  const sim::Scene scene = a.preset.empty() ? sim::load_scene(a.scene_file) : sim::preset_scene(a.preset);
+  const sim::Scene scene =
+      a.preset.empty() ? sim::load_scene(a.scene_file) : sim::preset_scene(a.preset);
   if (!a.preset.empty()) sim::validate_scene(scene, "preset " + a.preset);
   if (a.print_scene) {
     std::printf("%s\n", sim::scene_to_json(scene).dump(2).c_str());
+    return;
+  }
+  if (a.dry_run) {
+    const sim::SynthPlan plan = sim::plan_synthesis(scene, a.layout, a.seed);
+    std::printf(
+        "scene \"%s\", %s layout: %zu RIRs (%zu microphone positions x %zu heading(s) x %zu "
+        "source(s)), %d channel(s) at %d Hz, %.3g s each; %zu + %zu images at %dx%d\n",
+        scene.name.c_str(), plan.layout.c_str(), plan.jobs.size(), plan.microphones.size(),
+        plan.binaural ? plan.headings_deg.size() : size_t{1}, scene.sources.size(),
+        plan.binaural ? 2 : 1, plan.sample_rate, scene.acoustics.rir_length_s,
+        plan.train_cameras.size(), plan.eval_cameras.size(), scene.cameras.width,
+        scene.cameras.height);
     return;
   }
   require(!a.out_dir.empty(), "synth: --out DIR is required (the dataset folder to create)");
@@ -50,11 +63,12 @@ void run_synth(const SynthArgs& a) {
   opt.hrtf_path = a.hrtf;
   const sim::SynthSummary s = sim::synthesize(scene, opt);
 
-  std::printf("synthesised scene \"%s\" in the %s layout into %s\n", scene.name.c_str(), s.layout.c_str(),
-              s.out_dir.c_str());
-  std::printf("  RIRs:   %lld (%lld train / %lld test), %d channel(s) at %d Hz, %d microphone positions",
-              static_cast<long long>(s.num_rirs), static_cast<long long>(s.num_train_rirs),
-              static_cast<long long>(s.num_test_rirs), s.channels, s.sample_rate, s.num_microphones);
+  std::printf("synthesised scene \"%s\" in the %s layout into %s\n", scene.name.c_str(),
+              s.layout.c_str(), s.out_dir.c_str());
+  std::printf(
+      "  RIRs:   %lld (%lld train / %lld test), %d channel(s) at %d Hz, %d microphone positions",
+      static_cast<long long>(s.num_rirs), static_cast<long long>(s.num_train_rirs),
+      static_cast<long long>(s.num_test_rirs), s.channels, s.sample_rate, s.num_microphones);
   if (s.layout == "soundspaces") std::printf(" x %d headings", s.num_headings);
   std::printf(" x %d source(s); gain %.4g, peak %.3f\n", s.num_sources, s.gain, s.peak);
   std::printf("  images: %d train / %d eval at %dx%d\n", s.num_train_images, s.num_eval_images,
@@ -70,15 +84,17 @@ void register_synth(CLI::App& app) {
   auto args = std::make_shared<SynthArgs>();
   CLI::App* cmd = app.add_subcommand(
       "synth",
-      "Simulate an audio-visual dataset of a room: photos (ray-cast, textured, lit) and room impulse "
+      "Simulate an audio-visual dataset of a room: photos (ray-cast, textured, lit) and room "
+      "impulse "
       "responses (image sources + late reverb; binaural with an HRTF for the soundspaces layout, "
       "mono for raf), written in the folder layout NeRAF reads. The room is a scene JSON "
       "(docs/SCENE_FORMAT.md) or a preset. Same seed -> byte-identical files.");
   cmd->add_option("--scene", args->scene_file, "Scene description (JSON, see docs/SCENE_FORMAT.md)")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--preset", args->preset,
-                  "Built-in scene instead of --scene: demo (small furnished room, trains in minutes), "
-                  "shoebox (empty room), furnished (larger room, more data)");
+  cmd->add_option(
+      "--preset", args->preset,
+      "Built-in scene instead of --scene: demo (small furnished room, trains in minutes), "
+      "shoebox (empty room), furnished (larger room, more data)");
   cmd->add_option("--layout", args->layout,
                   "Output layout: soundspaces (binaural 44.1 kHz RIRs, 4 headings, "
                   "train_/eval_ images) or raf (mono 48 kHz RIRs, directional sources, "
@@ -95,12 +111,16 @@ void register_synth(CLI::App& app) {
   cmd->add_option("--hrtf", args->hrtf,
                   "SOFA file of the binaural HRTF (default: libmysofa's MIT KEMAR default.sofa)")
       ->check(CLI::ExistingFile);
-  cmd->add_flag("--force", args->force,
-                "Write into a non-empty --out folder, replacing files atomically (other files stay)");
+  cmd->add_flag(
+      "--force", args->force,
+      "Write into a non-empty --out folder, replacing files atomically (other files stay)");
   cmd->add_flag("--quiet", args->quiet, "No progress bars");
   cmd->add_flag("--print-scene", args->print_scene,
                 "Print the resolved scene JSON (e.g. of a preset, to edit and pass back with "
                 "--scene) and exit");
+  cmd->add_flag("--dry-run", args->dry_run,
+                "Print how many RIRs and images the scene gives in this layout and exit (writes "
+                "nothing)");
   cmd->callback([args] { run_synth(*args); });
 }
 

@@ -1,9 +1,12 @@
 #include "neraf/dsp/griffin_lim.h"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
+#include <utility>
 
 #if defined(__AVX512F__) || defined(__AVX2__)
 #include <immintrin.h>
@@ -91,6 +94,18 @@ void momentum_update(float* b, float* prev, const float* mag, int n_freq, float 
   }
 }
 
+// Calls fn(i) for i in [0, n): shared by the current team's threads (an orphaned `omp for`, with
+// its barrier) when `team`, else all on this thread.
+template <typename Fn>
+void team_for(bool team, int64_t n, const Fn& fn) {
+  if (team) {
+#pragma omp for schedule(static)
+    for (int64_t i = 0; i < n; ++i) fn(i);
+  } else {
+    for (int64_t i = 0; i < n; ++i) fn(i);
+  }
+}
+
 // Frames run in parallel only when the work pays for the threads.
 constexpr int64_t kParallelSamples = 16384;
 
@@ -163,66 +178,79 @@ std::vector<std::vector<float>> run(const std::vector<const Matrix*>& mags, cons
     }
   }
 
-  const int64_t n_blocks_per_ch = (c1 + hop - 1) / hop - c0 / hop;
+  const int64_t n_blocks = (c1 + hop - 1) / hop - c0 / hop;  // output blocks of hop samples
   const int64_t block_first = c0 / hop;
-  const int64_t n_frames_all = int64_t(n_ch) * T;
-  const bool parallel = n_frames_all * n >= kParallelSamples;
 
-  // One parallel region for the whole run, two barriers per iteration: every loop below is split
-  // statically over frames or output blocks, and each result is computed by the same arithmetic
-  // whichever thread runs it.
-#pragma omp parallel if (parallel)
-  {
-    // Per thread: the windowed frame fed to the r2c (zero outside the window support, which is
-    // never written) and the reflected samples of frames that reach into the centre padding.
-    AlignedFloats scratch = detail::alloc_floats(n);
-    std::vector<float> edge(n, 0.0f);
-#pragma omp for schedule(static)
-    for (int64_t i = 0; i < n_frames_all; ++i) {
-      Channel& s = ch[i / T];
-      e.inverse_frame(s.spec.get() + size_t(i % T) * sstride,
-                      s.frames.get() + size_t(i % T) * fstride);
-    }
+  // Runs all iterations for channels [c_lo, c_hi). With `team` the loops are shared by the
+  // threads of the enclosing parallel region (orphaned omp for: two barriers per iteration);
+  // without, this thread does everything. Either way each value is computed by the same
+  // arithmetic, so the mode never changes the result.
+  auto iterate = [&](int c_lo, int c_hi, bool team, float* scratch, float* edge) {
+    const int64_t nc = c_hi - c_lo;
+    auto frame_at = [&](int64_t i) { return std::pair<Channel*, int>(&ch[c_lo + i / T], i % T); };
+    // x = istft(S·a, length): overlap-add the inverse-transformed frames, divide by the envelope.
+    auto overlap_add = [&](int64_t i) {
+      Channel& s = ch[c_lo + i / n_blocks];
+      const int64_t k = block_first + i % n_blocks;
+      e.overlap_add(s.frames.get(), T, c0, c1, inv_env.data(), k * hop, (k + 1) * hop,
+                    s.sig.data() + c0);
+    };
+    team_for(team, nc * T, [&](int64_t i) {
+      auto [s, t] = frame_at(i);
+      e.inverse_frame(s->spec.get() + size_t(t) * sstride, s->frames.get() + size_t(t) * fstride);
+    });
     for (int it = 0; it < o.n_iter; ++it) {
-      // x = istft(S·a, length): overlap-add the inverse-transformed frames, divide by the envelope.
-#pragma omp for schedule(static)
-      for (int64_t i = 0; i < int64_t(n_ch) * n_blocks_per_ch; ++i) {
-        Channel& s = ch[i / n_blocks_per_ch];
-        const int64_t k = block_first + i % n_blocks_per_ch;
-        e.overlap_add(s.frames.get(), T, c0, c1, inv_env.data(), k * hop, (k + 1) * hop,
-                      s.sig.data() + c0);
-      }
+      team_for(team, nc * n_blocks, overlap_add);
       // r = stft(x) with x centre-padded by reflection (center=True, pad_mode="reflect");
       // a = r − m·prev; a /= |a| + 1e-16; prev = r; then S·a and its inverse FFT for the next
       // istft, all while the frame is in cache. Frames that reach into the padding read the
       // reflected samples through `edge` (no separate padding pass: one barrier less).
-#pragma omp for schedule(static)
-      for (int64_t i = 0; i < n_frames_all; ++i) {
-        Channel& s = ch[i / T];
-        const int t = static_cast<int>(i % T);
-        float* b = s.spec.get() + size_t(t) * sstride;
+      team_for(team, nc * T, [&](int64_t i) {
+        auto [s, t] = frame_at(i);
+        float* b = s->spec.get() + size_t(t) * sstride;
         const int64_t start = int64_t(t) * hop;
         if (start + e.support_begin() >= off && start + e.support_end() <= off + iter_len) {
-          e.forward_frame(s.sig.data() + start + e.support_begin(), scratch.get(), b);
+          e.forward_frame(s->sig.data() + start + e.support_begin(), scratch, b);
         } else {
-          const float* x = s.sig.data() + off;
+          const float* x = s->sig.data() + off;
           for (int j = 0; j < e.support_end() - e.support_begin(); ++j) {
             const int64_t k = start + e.support_begin() + j - off;  // index into x, maybe outside
             edge[j] = (k >= 0 && k < iter_len) ? x[k] : x[detail::reflect_index(k, iter_len)];
           }
-          e.forward_frame(edge.data(), scratch.get(), b);
+          e.forward_frame(edge, scratch, b);
         }
-        momentum_update(b, s.prev.data() + size_t(t) * 2 * F, s.mag.data() + size_t(t) * F, F, m);
-        e.inverse_frame(b, s.frames.get() + size_t(t) * fstride);
-      }
+        momentum_update(b, s->prev.data() + size_t(t) * 2 * F, s->mag.data() + size_t(t) * F, F, m);
+        e.inverse_frame(b, s->frames.get() + size_t(t) * fstride);
+      });
     }
-    // Final istft(S·a, length).
+    team_for(team, nc * n_blocks, overlap_add);  // the final istft(S·a, length)
+  };
+
+  // Per thread: the windowed frame fed to the r2c (zero outside the window support, which is
+  // never written) and the reflected samples of frames that reach into the centre padding.
+  const int n_threads = omp_get_max_threads();
+  const bool parallel =
+      int64_t(n_ch) * T * n >= kParallelSamples && n_threads > 1 && !omp_in_parallel();
+  if (!parallel) {
+    AlignedFloats scratch = detail::alloc_floats(n);
+    std::vector<float> edge(n, 0.0f);
+    iterate(0, n_ch, false, scratch.get(), edge.data());
+  } else if (n_ch % n_threads == 0) {
+    // Whole channels per thread (e.g. binaural on 2 cores): no barrier until the end, which also
+    // keeps the speed when other processes compete for the cores.
+#pragma omp parallel
+    {
+      AlignedFloats scratch = detail::alloc_floats(n);
+      std::vector<float> edge(n, 0.0f);
 #pragma omp for schedule(static)
-    for (int64_t i = 0; i < int64_t(n_ch) * n_blocks_per_ch; ++i) {
-      Channel& s = ch[i / n_blocks_per_ch];
-      const int64_t k = block_first + i % n_blocks_per_ch;
-      e.overlap_add(s.frames.get(), T, c0, c1, inv_env.data(), k * hop, (k + 1) * hop,
-                    s.sig.data() + c0);
+      for (int c = 0; c < n_ch; ++c) iterate(c, c + 1, false, scratch.get(), edge.data());
+    }
+  } else {
+#pragma omp parallel
+    {
+      AlignedFloats scratch = detail::alloc_floats(n);
+      std::vector<float> edge(n, 0.0f);
+      iterate(0, n_ch, true, scratch.get(), edge.data());
     }
   }
 

@@ -154,8 +154,9 @@ Spectrogram stft(const std::vector<float>& signal, const StftParams& p) {
   const bool parallel = int64_t(n_frames) * n >= detail::kParallelSamples;
 #pragma omp parallel if (parallel)
   {
-    detail::AlignedFloats scratch =
-        detail::alloc_floats(n);  // windowed frame, zero outside support
+    // Per thread: the windowed frame (zero outside the window support), its spectrum, and the
+    // reflected samples of frames that reach into the centre padding.
+    detail::AlignedFloats scratch = detail::alloc_floats(n);
     detail::AlignedFloats spec = detail::alloc_floats(e.spec_stride());
     std::vector<float> edge(n, 0.0f);
 #pragma omp for schedule(static)

@@ -13,8 +13,8 @@ namespace neraf::geometry {
 
 struct YawBox {
   Vec3 center;
-  Vec3 half;            // half extents along the local axes (all > 0)
-  double yaw_rad = 0;   // rotation about +y
+  Vec3 half;           // half extents along the local axes (all > 0)
+  double yaw_rad = 0;  // rotation about +y
 
   Vec3 to_local(Vec3 p) const { return rotate_y(p - center, -yaw_rad); }
   Vec3 dir_to_local(Vec3 d) const { return rotate_y(d, -yaw_rad); }
@@ -36,15 +36,16 @@ struct YawBox {
 
 struct BoxHit {
   double t = std::numeric_limits<double>::infinity();  // ray parameter of the entry point
-  Vec3 normal_local;                                    // outward normal of the entered face
-  int axis = -1;                                        // local axis of that face (0, 1, 2)
+  Vec3 normal_local;                                   // outward normal of the entered face
+  int axis = -1;                                       // local axis of that face (0, 1, 2)
 };
 
 // Ray (origin o, direction d, not necessarily unit) against the box from OUTSIDE: the entry point
 // with t in (t_min, t_max). Returns false when the ray misses or starts inside.
 inline bool intersect(const YawBox& box, Vec3 o, Vec3 d, double t_min, double t_max, BoxHit* hit) {
   const Vec3 lo = box.to_local(o), ld = box.dir_to_local(d);
-  double t0 = -std::numeric_limits<double>::infinity(), t1 = std::numeric_limits<double>::infinity();
+  double t0 = -std::numeric_limits<double>::infinity(),
+         t1 = std::numeric_limits<double>::infinity();
   int axis = -1;
   double sign = 0;
   for (int a = 0; a < 3; ++a) {

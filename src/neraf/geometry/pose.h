@@ -24,7 +24,8 @@ inline Vec3 heading_forward(double yaw_deg) {
 }
 inline Vec3 heading_left(double yaw_deg) { return heading_forward(yaw_deg + 90.0); }
 
-struct Quaternion {  // unit quaternion, stored real LAST like scipy's as_quat() and RAF's tx_pos.txt
+struct Quaternion {  // unit quaternion, stored real LAST like scipy's as_quat() and RAF's
+                     // tx_pos.txt
   double x = 0, y = 0, z = 0, w = 1;
 };
 

@@ -49,23 +49,32 @@ struct HashGridLayout {
   static HashGridLayout make(const HashGridConfig& config);
 };
 
+// Which code path the kernels take. kBest uses AVX-512 for float32 with F = 2 when the build
+// targets it (-march=native on an AVX-512 machine) and the portable scalar code otherwise; the two
+// paths produce bit-identical results (the tests check it). kScalar forces the portable code.
+enum class HashGridPath { kBest, kScalar };
+
+// True when this build contains the AVX-512 path.
+bool hash_grid_has_simd();
+
 // All kernels: x is [n, 3] row-major; num_threads ≥ 1 OpenMP threads. Deterministic: the result
-// bits do not depend on num_threads.
+// bits do not depend on num_threads (nor on the path).
 
 // out: [n, L·F], fully overwritten. Level-outer, point-inner (one level's table stays hot in
 // cache), points split across threads within a level.
 template <typename T>
 void hash_grid_forward_cpu(const T* x, int64_t n, const T* table, const HashGridLayout& layout,
-                           T* out, int num_threads);
+                           T* out, int num_threads, HashGridPath path = HashGridPath::kBest);
 
 // Gradient w.r.t. the table, ACCUMULATED into grad_table ([total_entries, F]; zero it first for a
 // plain gradient). grad_out: [n, L·F]. Levels are owned by threads (no atomics); within a level
 // points are accumulated in index order, so the bits do not depend on num_threads.
 // If grad_x is not null ([n, 3], overwritten) the gradient w.r.t. x is computed in the same pass
-// (needs `table`; summed over levels in level order, also thread-count independent).
+// (needs `table`, which may be null otherwise; summed over levels in level order, also
+// thread-count independent).
 template <typename T>
 void hash_grid_backward_cpu(const T* x, int64_t n, const T* table, const T* grad_out,
-                            const HashGridLayout& layout, T* grad_table, T* grad_x,
-                            int num_threads);
+                            const HashGridLayout& layout, T* grad_table, T* grad_x, int num_threads,
+                            HashGridPath path = HashGridPath::kBest);
 
 }  // namespace neraf::nerf

@@ -54,7 +54,8 @@ std::vector<CameraView> place_cameras(const Scene& scene, int count, uint64_t se
       s -= w;
       p.x = m, p.z = m + d - s;
     }
-    Vec3 target = centre + Vec3{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)} * cam.look_jitter_m;
+    Vec3 target = centre + Vec3{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)} *
+                               cam.look_jitter_m;
     for (int a = 0; a < 3; ++a) {
       target[a] = std::clamp(target[a], kSurfaceClearanceM, scene.size[a] - kSurfaceClearanceM);
     }

@@ -21,7 +21,9 @@ uint32_t hash3(int32_t a, int32_t b, uint32_t c) {
   return h;
 }
 
-double lattice(int32_t i, int32_t j, uint32_t face) { return (hash3(i, j, face) >> 8) * (1.0 / 16777216.0); }
+double lattice(int32_t i, int32_t j, uint32_t face) {
+  return (hash3(i, j, face) >> 8) * (1.0 / 16777216.0);
+}
 
 // Smooth value noise in [0, 1] with unit cell size.
 double value_noise(double x, double y, uint32_t face) {
@@ -40,7 +42,8 @@ constexpr double kEps = 1e-9;
 
 double texture_factor(const Texture& t, double u, double v, uint32_t face_id) {
   if (t.kind == "checker") {
-    const auto parity = static_cast<int64_t>(std::floor(u / t.scale_m)) + static_cast<int64_t>(std::floor(v / t.scale_m));
+    const auto parity = static_cast<int64_t>(std::floor(u / t.scale_m)) +
+                        static_cast<int64_t>(std::floor(v / t.scale_m));
     return (parity & 1) ? 1.0 - t.contrast : 1.0;
   }
   if (t.kind == "stripes") {
@@ -48,8 +51,9 @@ double texture_factor(const Texture& t, double u, double v, uint32_t face_id) {
     return f >= 0.5 ? 1.0 - t.contrast : 1.0;
   }
   if (t.kind == "noise") {
-    const double n = 0.65 * value_noise(u / t.scale_m, v / t.scale_m, face_id) +
-                     0.35 * value_noise(2 * u / t.scale_m, 2 * v / t.scale_m, face_id ^ 0x5bd1e995u);
+    const double n =
+        0.65 * value_noise(u / t.scale_m, v / t.scale_m, face_id) +
+        0.35 * value_noise(2 * u / t.scale_m, 2 * v / t.scale_m, face_id ^ 0x5bd1e995u);
     return 1.0 - t.contrast * n;
   }
   return 1.0;
@@ -113,12 +117,14 @@ ImageRenderer::Hit ImageRenderer::intersect(Vec3 o, Vec3 d) const {
     hit.normal = box.dir_to_world(bh.normal_local);
     hit.surface = 6 + static_cast<int>(i);
     hit.material = box_materials_[i];
-    // Face coordinates in the box's own frame (from its minimum corner), so textures follow the box.
+    // Face coordinates in the box's own frame (from its minimum corner), so textures follow the
+    // box.
     const Vec3 l = box.to_local(hit.point) + box.half;
     if (bh.axis == 0) hit.u = l.z, hit.v = l.y;
     if (bh.axis == 1) hit.u = l.x, hit.v = l.z;
     if (bh.axis == 2) hit.u = l.x, hit.v = l.y;
-    hit.face_id = static_cast<uint32_t>(6 + 6 * i + 2 * bh.axis + (bh.normal_local[bh.axis] > 0 ? 1 : 0));
+    hit.face_id =
+        static_cast<uint32_t>(6 + 6 * i + 2 * bh.axis + (bh.normal_local[bh.axis] > 0 ? 1 : 0));
   }
   return hit;
 }

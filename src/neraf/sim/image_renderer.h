@@ -40,10 +40,10 @@ class ImageRenderer {
   RgbImage render(const CameraView& view, int supersampling) const;
 
   struct Hit {
-    double t = 0;        // distance along the (unit) ray
-    Vec3 point, normal;  // normal faces the side the ray came from
-    int surface = -1;    // 0..5 room faces (x0, x1, floor, ceiling, z0, z1), 6 + i furniture[i]
-    double u = 0, v = 0; // face coordinates (metres) for the texture
+    double t = 0;         // distance along the (unit) ray
+    Vec3 point, normal;   // normal faces the side the ray came from
+    int surface = -1;     // 0..5 room faces (x0, x1, floor, ceiling, z0, z1), 6 + i furniture[i]
+    double u = 0, v = 0;  // face coordinates (metres) for the texture
     uint32_t face_id = 0;
     const Material* material = nullptr;
   };

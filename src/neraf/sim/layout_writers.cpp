@@ -71,8 +71,9 @@ std::vector<uint8_t> encode_png(const RgbImage& image) {
   };
   const int ok = stbi_write_png_to_func(append, &bytes, image.width, image.height, 3,
                                         image.pixels.data(), image.width * 3);
-  if (!ok) throw Error("PNG encoding failed for a " + std::to_string(image.width) + "x" +
-                       std::to_string(image.height) + " image");
+  if (!ok)
+    throw Error("PNG encoding failed for a " + std::to_string(image.width) + "x" +
+                std::to_string(image.height) + " image");
   return bytes;
 }
 
@@ -80,7 +81,8 @@ void write_png(const std::string& path, const RgbImage& image) {
   const auto bytes = encode_png(image);
   io::write_atomically(path, [&](const std::string& tmp) {
     std::ofstream out(tmp, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
     out.flush();
     require(out.good(), path + ": write failed (disk full?); free space and retry");
   });
@@ -93,7 +95,8 @@ void write_wav_float(const std::string& path, const std::vector<std::vector<floa
   const int nc = static_cast<int>(channels.size());
   for (const auto& ch : channels) {
     require(ch.size() == n, path + ": all audio channels must have the same length");
-    for (float v : ch) require(std::isfinite(v), path + ": refusing to write NaN or infinite samples");
+    for (float v : ch)
+      require(std::isfinite(v), path + ": refusing to write NaN or infinite samples");
   }
   std::vector<float> interleaved(n * nc);
   for (size_t i = 0; i < n; ++i) {
@@ -105,7 +108,9 @@ void write_wav_float(const std::string& path, const std::vector<std::vector<floa
     info.channels = nc;
     info.format = SF_FORMAT_WAV | SF_FORMAT_FLOAT;
     SNDFILE* file = sf_open(tmp.c_str(), SFM_WRITE, &info);
-    if (!file) throw Error(path + ": cannot open for writing (" + sf_strerror(nullptr) + "); choose a writable output path");
+    if (!file)
+      throw Error(path + ": cannot open for writing (" + sf_strerror(nullptr) +
+                  "); choose a writable output path");
     // The PEAK chunk stores the wall-clock time of writing: drop it for reproducible files.
     sf_command(file, SFC_SET_ADD_PEAK_CHUNK, nullptr, SF_FALSE);
     const sf_count_t wrote = sf_writef_float(file, interleaved.data(), static_cast<sf_count_t>(n));
@@ -133,8 +138,8 @@ std::string soundspaces_points_txt(const std::vector<Vec3>& world_points) {
 }
 
 std::string soundspaces_rir_name(double heading_deg, int receiver, int source) {
-  return std::to_string(static_cast<long>(std::lround(heading_deg))) + "/" + std::to_string(receiver) +
-         "_" + std::to_string(source);
+  return std::to_string(static_cast<long>(std::lround(heading_deg))) + "/" +
+         std::to_string(receiver) + "_" + std::to_string(source);
 }
 
 namespace {
@@ -177,7 +182,8 @@ std::string raf_rx_pos(Vec3 p) {
 std::string raf_tx_pos(Vec3 p, double yaw_deg) {
   const auto q = geometry::quaternion_from_yaw(yaw_deg);
   char buf[256];
-  std::snprintf(buf, sizeof buf, "%.9f,%.9f,%.9f,%.9f,%.6f,%.6f,%.6f\n", q.x, q.y, q.z, q.w, p.x, p.y, p.z);
+  std::snprintf(buf, sizeof buf, "%.9f,%.9f,%.9f,%.9f,%.6f,%.6f,%.6f\n", q.x, q.y, q.z, q.w, p.x,
+                p.y, p.z);
   return buf;
 }
 
@@ -190,7 +196,8 @@ json raf_data_split(const std::vector<std::string>& ids, uint64_t seed, double t
     for (size_t k = i; k < std::min(i + 6, tst.size()); ++k) group.push_back(tst[k]);
     validation.push_back(group);
   }
-  return {{"train", json::array({train})}, {"validation", validation}, {"test", json::array({tst})}};
+  return {
+      {"train", json::array({train})}, {"validation", validation}, {"test", json::array({tst})}};
 }
 
 }  // namespace neraf::sim

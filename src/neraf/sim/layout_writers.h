@@ -1,10 +1,11 @@
 #pragma once
 // Writers of the dataset layouts NeRAF reads (docs/SCENE_FORMAT.md "Output layouts";
 // neraf-reference.md §3.2 SoundSpaces, §3.3 RAF) and of the nerfstudio transforms.json.
-// Pure formatting functions (tested on their own) + a few writers; every file is written atomically.
-#include <nlohmann/json.hpp>
+// Pure formatting functions (tested on their own) + a few writers; every file is written
+// atomically.
 #include <array>
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -27,7 +28,8 @@ struct FrameRecord {
 // transforms.json: camera_model "OPENCV", shared intrinsics fl_x, fl_y, cx, cy, w, h,
 // k1 = k2 = p1 = p2 = 0, frames [{file_path, transform_matrix (4×4 camera-to-world, OpenGL)}].
 // `orientation_override_none` adds "orientation_override": "none" (NeRAF's SoundSpaces files do).
-nlohmann::json nerfstudio_transforms(const CameraIntrinsics& k, const std::vector<FrameRecord>& frames,
+nlohmann::json nerfstudio_transforms(const CameraIntrinsics& k,
+                                     const std::vector<FrameRecord>& frames,
                                      bool orientation_override_none);
 
 // nerfstudio's eval_mode "fraction" rule (what NeRAF uses for RAF): with n images the train set is
@@ -70,7 +72,7 @@ nlohmann::json soundspaces_split(const std::vector<std::string>& names, uint64_t
 
 // ---------------------------------------------------------------- RAF
 
-std::string raf_id(int index);  // 6 digits: "000012"
+std::string raf_id(int index);          // 6 digits: "000012"
 std::string raf_rx_pos(Vec3 position);  // "x,y,z"
 // "qx,qy,qz,qw,x,y,z": the source orientation as a real-LAST quaternion, the rotation R_y(yaw)
 // about +y that turns the forward axis −z into forward(yaw); scipy's

@@ -50,7 +50,8 @@ Scene demo() {
   s.materials["floor"] = material({0.55, 0.40, 0.28}, "stripes", 0.3, 0.25, kWoodFloor, 0.1);
   s.materials["ceiling"] = material({0.88, 0.88, 0.86}, "noise", 0.5, 0.12, kAcousticCeiling, 0.2);
   s.materials["wall"] = material({0.78, 0.74, 0.66}, "noise", 0.2, 0.25, kPaintedPlaster, 0.1);
-  s.materials["wallpaper"] = material({0.50, 0.62, 0.74}, "stripes", 0.2, 0.3, kPaintedPlaster, 0.1);
+  s.materials["wallpaper"] =
+      material({0.50, 0.62, 0.74}, "stripes", 0.2, 0.3, kPaintedPlaster, 0.1);
   s.materials["wood"] = material({0.62, 0.42, 0.24}, "stripes", 0.08, 0.2, kWoodFurniture, 0.1);
   s.materials["fabric"] = material({0.70, 0.25, 0.20}, "checker", 0.15, 0.3, kUpholstery, 0.5);
   s.materials["shelf"] = material({0.30, 0.32, 0.38}, "checker", 0.3, 0.35, kBooks, 0.6);
@@ -116,7 +117,8 @@ Scene furnished() {
   s.materials["floor"] = material({0.50, 0.36, 0.24}, "stripes", 0.25, 0.25, kWoodFloor, 0.1);
   s.materials["ceiling"] = material({0.90, 0.90, 0.88}, "noise", 0.6, 0.1, kAcousticCeiling, 0.2);
   s.materials["wall"] = material({0.80, 0.76, 0.68}, "noise", 0.25, 0.25, kPaintedPlaster, 0.1);
-  s.materials["wallpaper"] = material({0.45, 0.58, 0.50}, "stripes", 0.18, 0.3, kPaintedPlaster, 0.1);
+  s.materials["wallpaper"] =
+      material({0.45, 0.58, 0.50}, "stripes", 0.18, 0.3, kPaintedPlaster, 0.1);
   s.materials["tiles"] = material({0.70, 0.70, 0.72}, "checker", 0.3, 0.2, kPaintedPlaster, 0.1);
   s.materials["wood"] = material({0.62, 0.42, 0.24}, "stripes", 0.08, 0.2, kWoodFurniture, 0.1);
   s.materials["dark_wood"] = material({0.35, 0.22, 0.14}, "noise", 0.1, 0.3, kWoodFurniture, 0.2);

@@ -46,7 +46,7 @@ struct RoomSurfaces {  // material names for the six faces of the room
 
 struct Source {
   Vec3 position;
-  double yaw_deg = 0;              // facing direction of a directional source
+  double yaw_deg = 0;                // facing direction of a directional source
   std::string directivity = "omni";  // "omni" | "cardioid"
 };
 
@@ -92,8 +92,8 @@ struct Light {
 
 struct Acoustics {
   double speed_of_sound = 343.0;
-  int max_order = 8;           // image-source reflection order
-  double rir_length_s = 1.0;   // length of every written RIR
+  int max_order = 8;          // image-source reflection order
+  double rir_length_s = 1.0;  // length of every written RIR
 };
 
 // Materials every scene has unless it redefines them: the names RoomSurfaces uses by default.

@@ -50,7 +50,8 @@ std::string fmt(Vec3 v) { return "[" + fmt(v.x) + ", " + fmt(v.y) + ", " + fmt(v
 // Checks `j` is an object and has no keys outside `known`.
 void check_object(const Ctx& c, const json& j, const std::string& path,
                   std::initializer_list<const char*> known) {
-  if (!j.is_object()) fail(c, path, path.empty() ? "must be a JSON object {...}" : "must be an object {...}");
+  if (!j.is_object())
+    fail(c, path, path.empty() ? "must be a JSON object {...}" : "must be an object {...}");
   std::vector<std::string> unknown;
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (std::none_of(known.begin(), known.end(), [&](const char* k) { return it.key() == k; }))
@@ -80,11 +81,13 @@ double read_number(const Ctx& c, const json& j, const std::string& path, const s
 int read_int(const Ctx& c, const json& j, const std::string& path, const std::string& what) {
   if (!j.is_number()) fail(c, path, "must be " + what);
   const double v = j.get<double>();
-  if (!std::isfinite(v) || v != std::floor(v) || std::abs(v) > 1e9) fail(c, path, "must be " + what);
+  if (!std::isfinite(v) || v != std::floor(v) || std::abs(v) > 1e9)
+    fail(c, path, "must be " + what);
   return static_cast<int>(v);
 }
 
-std::string read_string(const Ctx& c, const json& j, const std::string& path, const std::string& what) {
+std::string read_string(const Ctx& c, const json& j, const std::string& path,
+                        const std::string& what) {
   if (!j.is_string()) fail(c, path, "must be " + what);
   return j.get<std::string>();
 }
@@ -120,10 +123,12 @@ Texture read_texture(const Ctx& c, const json& j, const std::string& path) {
   opt(j, "kind", path, t.kind, [&](const json& v, const std::string& p) {
     return read_string(c, v, p, "one of \"none\", \"checker\", \"stripes\", \"noise\"");
   });
-  opt(j, "scale_m", path, t.scale_m,
-      [&](const json& v, const std::string& p) { return read_number(c, v, p, "a positive number (metres)"); });
-  opt(j, "contrast", path, t.contrast,
-      [&](const json& v, const std::string& p) { return read_number(c, v, p, "a number in [0, 1]"); });
+  opt(j, "scale_m", path, t.scale_m, [&](const json& v, const std::string& p) {
+    return read_number(c, v, p, "a positive number (metres)");
+  });
+  opt(j, "contrast", path, t.contrast, [&](const json& v, const std::string& p) {
+    return read_number(c, v, p, "a number in [0, 1]");
+  });
   return t;
 }
 
@@ -138,8 +143,9 @@ Material read_material(const Ctx& c, const json& j, const std::string& path) {
     if (a.size() != 7) fail(c, join(path, "absorption"), std::string("must be ") + kAbsorption);
     std::copy(a.begin(), a.end(), m.absorption.begin());
   }
-  opt(j, "scattering", path, m.scattering,
-      [&](const json& v, const std::string& p) { return read_number(c, v, p, "a number in [0, 1]"); });
+  opt(j, "scattering", path, m.scattering, [&](const json& v, const std::string& p) {
+    return read_number(c, v, p, "a number in [0, 1]");
+  });
   return m;
 }
 
@@ -209,7 +215,8 @@ Scene scene_from_json(const json& j, const std::string& origin) {
   }
 
   if (const json* f = find(j, "furniture")) {
-    if (!f->is_array()) fail(c, "furniture", "must be a list of boxes [{\"center\": ..., \"size\": ...}, ...]");
+    if (!f->is_array())
+      fail(c, "furniture", "must be a list of boxes [{\"center\": ..., \"size\": ...}, ...]");
     for (size_t i = 0; i < f->size(); ++i) {
       const std::string p = index("furniture", i);
       const json& e = (*f)[i];
@@ -256,17 +263,22 @@ Scene scene_from_json(const json& j, const std::string& origin) {
       opt(*g, "spacing_m", q, grid.spacing_m, number("a positive number (metres)"));
       opt(*g, "height_m", q, grid.height_m, number("a number inside the room height (metres)"));
       opt(*g, "wall_margin_m", q, grid.wall_margin_m, number("a number >= 0 (metres)"));
-      if (const json* h = find(*g, "headings_deg")) grid.headings_deg = read_headings(c, *h, join(q, "headings_deg"));
+      if (const json* h = find(*g, "headings_deg"))
+        grid.headings_deg = read_headings(c, *h, join(q, "headings_deg"));
     }
     if (const json* r = find(*m, "random")) {
       const std::string q = join(p, "random");
-      check_object(c, *r, q, {"count", "min_height_m", "max_height_m", "wall_margin_m", "headings_deg"});
+      check_object(c, *r, q,
+                   {"count", "min_height_m", "max_height_m", "wall_margin_m", "headings_deg"});
       auto& rnd = s.microphones.random;
       opt(*r, "count", q, rnd.count, integer("a positive whole number"));
-      opt(*r, "min_height_m", q, rnd.min_height_m, number("a number inside the room height (metres)"));
-      opt(*r, "max_height_m", q, rnd.max_height_m, number("a number inside the room height (metres)"));
+      opt(*r, "min_height_m", q, rnd.min_height_m,
+          number("a number inside the room height (metres)"));
+      opt(*r, "max_height_m", q, rnd.max_height_m,
+          number("a number inside the room height (metres)"));
       opt(*r, "wall_margin_m", q, rnd.wall_margin_m, number("a number >= 0 (metres)"));
-      if (const json* h = find(*r, "headings_deg")) rnd.headings_deg = read_headings(c, *h, join(q, "headings_deg"));
+      if (const json* h = find(*r, "headings_deg"))
+        rnd.headings_deg = read_headings(c, *h, join(q, "headings_deg"));
     }
   }
 
@@ -283,8 +295,10 @@ Scene scene_from_json(const json& j, const std::string& origin) {
     opt(*m, "fov_deg", p, cam.fov_deg, number("a horizontal field of view in [10, 170] degrees"));
     opt(*m, "wall_margin_m", p, cam.wall_margin_m, number("a number >= 0 (metres)"));
     opt(*m, "look_jitter_m", p, cam.look_jitter_m, number("a number >= 0 (metres)"));
-    opt(*m, "min_height_m", p, cam.min_height_m, number("a number inside the room height (metres)"));
-    opt(*m, "max_height_m", p, cam.max_height_m, number("a number inside the room height (metres)"));
+    opt(*m, "min_height_m", p, cam.min_height_m,
+        number("a number inside the room height (metres)"));
+    opt(*m, "max_height_m", p, cam.max_height_m,
+        number("a number inside the room height (metres)"));
     opt(*m, "supersampling", p, cam.supersampling, integer("a whole number in [1, 8]"));
   }
 
@@ -324,12 +338,13 @@ void check_headings(const Ctx& c, const std::vector<double>& h, const std::strin
   if (h.empty()) fail(c, path, std::string("must be ") + kHeadings);
 }
 
-void check_height_range(const Ctx& c, const Scene& s, double lo, double hi, const std::string& path) {
+void check_height_range(const Ctx& c, const Scene& s, double lo, double hi,
+                        const std::string& path) {
   if (!(lo >= kSurfaceClearanceM && lo <= hi && hi <= s.size.y - kSurfaceClearanceM))
     fail(c, path + ".min_height_m",
          "min_height_m " + fmt(lo) + " and max_height_m " + fmt(hi) + " must satisfy " +
-             fmt(kSurfaceClearanceM) + " <= min <= max <= room height - " + fmt(kSurfaceClearanceM) +
-             " = " + fmt(s.size.y - kSurfaceClearanceM));
+             fmt(kSurfaceClearanceM) + " <= min <= max <= room height - " +
+             fmt(kSurfaceClearanceM) + " = " + fmt(s.size.y - kSurfaceClearanceM));
 }
 
 }  // namespace
@@ -338,34 +353,41 @@ void validate_scene(const Scene& s, const std::string& origin) {
   const Ctx c{origin};
   if (s.name.empty()) fail(c, "name", "must be a non-empty string");
   if (!(is_finite(s.size) && s.size.x > 0 && s.size.y > 0 && s.size.z > 0))
-    fail(c, "size", std::string("must be ") + kThreePositive + " (room extent in metres along x, y (up), z)");
-  const std::string room = "the room [0, " + fmt(s.size.x) + "] x [0, " + fmt(s.size.y) + "] x [0, " +
-                           fmt(s.size.z) + "]";
+    fail(c, "size",
+         std::string("must be ") + kThreePositive + " (room extent in metres along x, y (up), z)");
+  const std::string room = "the room [0, " + fmt(s.size.x) + "] x [0, " + fmt(s.size.y) +
+                           "] x [0, " + fmt(s.size.z) + "]";
 
   for (const auto& [name, m] : s.materials) {
     const std::string p = "materials." + name;
     if (name.empty()) fail(c, "materials", "material names must not be empty");
     for (int i = 0; i < 3; ++i) {
-      if (!(m.albedo[i] >= 0 && m.albedo[i] <= 1)) fail(c, p + ".albedo", std::string("must be ") + kAlbedo);
+      if (!(m.albedo[i] >= 0 && m.albedo[i] <= 1))
+        fail(c, p + ".albedo", std::string("must be ") + kAlbedo);
     }
     const auto& t = m.texture;
     if (t.kind != "none" && t.kind != "checker" && t.kind != "stripes" && t.kind != "noise")
       fail(c, p + ".texture.kind",
-           "unknown texture \"" + t.kind + "\"; use one of \"none\", \"checker\", \"stripes\", \"noise\"");
+           "unknown texture \"" + t.kind +
+               "\"; use one of \"none\", \"checker\", \"stripes\", \"noise\"");
     if (!(t.scale_m > 0 && std::isfinite(t.scale_m)))
       fail(c, p + ".texture.scale_m", "must be a positive number (metres)");
-    if (!(t.contrast >= 0 && t.contrast <= 1)) fail(c, p + ".texture.contrast", "must be a number in [0, 1]");
+    if (!(t.contrast >= 0 && t.contrast <= 1))
+      fail(c, p + ".texture.contrast", "must be a number in [0, 1]");
     for (double a : m.absorption) {
       if (!(a >= 0 && a < 1)) fail(c, p + ".absorption", std::string("must be ") + kAbsorption);
     }
-    if (!(m.scattering >= 0 && m.scattering <= 1)) fail(c, p + ".scattering", "must be a number in [0, 1]");
+    if (!(m.scattering >= 0 && m.scattering <= 1))
+      fail(c, p + ".scattering", "must be a number in [0, 1]");
   }
 
   const auto check_material = [&](const std::string& name, const std::string& path) {
     if (s.materials.count(name)) return;
     std::string known;
     for (const auto& kv : s.materials) known += (known.empty() ? "" : ", ") + kv.first;
-    fail(c, path, "unknown material \"" + name + "\" (defined: " + known + "); define it under \"materials\"");
+    fail(c, path,
+         "unknown material \"" + name + "\" (defined: " + known +
+             "); define it under \"materials\"");
   };
   check_material(s.surfaces.floor, "surfaces.floor");
   check_material(s.surfaces.ceiling, "surfaces.ceiling");
@@ -386,20 +408,23 @@ void validate_scene(const Scene& s, const std::string& origin) {
     const Vec3 h = furniture_box(b).world_half_extent();
     for (int a = 0; a < 3; ++a) {
       if (b.center[a] - h[a] < -kTol || b.center[a] + h[a] > s.size[a] + kTol)
-        fail(c, p, "the box (center " + fmt(b.center) + ", size " + fmt(b.size) + ", yaw " +
-                       fmt(b.yaw_deg) + " deg) reaches outside " + room + "; move or shrink it");
+        fail(c, p,
+             "the box (center " + fmt(b.center) + ", size " + fmt(b.size) + ", yaw " +
+                 fmt(b.yaw_deg) + " deg) reaches outside " + room + "; move or shrink it");
     }
   }
 
   const auto check_point = [&](Vec3 pos, const std::string& path, const std::string& what) {
     if (!is_finite(pos)) fail(c, path, std::string("must be ") + kThreeNumbers);
     if (!inside_room(s, pos, kSurfaceClearanceM))
-      fail(c, path, fmt(pos) + " is outside " + room + " (or closer than " + fmt(kSurfaceClearanceM) +
-                        " m to a surface); move the " + what + " into the room");
+      fail(c, path,
+           fmt(pos) + " is outside " + room + " (or closer than " + fmt(kSurfaceClearanceM) +
+               " m to a surface); move the " + what + " into the room");
     const int k = furniture_containing(s, pos, 0.0);
     if (k >= 0)
-      fail(c, path, fmt(pos) + " is inside furniture[" + std::to_string(k) + "]; move the " + what +
-                        " out of the box");
+      fail(c, path,
+           fmt(pos) + " is inside furniture[" + std::to_string(k) + "]; move the " + what +
+               " out of the box");
   };
 
   if (s.sources.empty()) fail(c, "sources", "needs at least one sound source");
@@ -409,7 +434,8 @@ void validate_scene(const Scene& s, const std::string& origin) {
     check_point(src.position, p + ".position", "source");
     if (!std::isfinite(src.yaw_deg)) fail(c, p + ".yaw_deg", "must be a number (degrees)");
     if (src.directivity != "omni" && src.directivity != "cardioid")
-      fail(c, p + ".directivity", "unknown directivity \"" + src.directivity + "\"; use \"omni\" or \"cardioid\"");
+      fail(c, p + ".directivity",
+           "unknown directivity \"" + src.directivity + "\"; use \"omni\" or \"cardioid\"");
   }
 
   const Microphones& mic = s.microphones;
@@ -418,7 +444,8 @@ void validate_scene(const Scene& s, const std::string& origin) {
   {
     const auto& g = mic.grid;
     const std::string p = "microphones.grid";
-    if (!(g.spacing_m > 0 && std::isfinite(g.spacing_m))) fail(c, p + ".spacing_m", "must be a positive number (metres)");
+    if (!(g.spacing_m > 0 && std::isfinite(g.spacing_m)))
+      fail(c, p + ".spacing_m", "must be a positive number (metres)");
     if (!(g.wall_margin_m >= 0 && std::isfinite(g.wall_margin_m)))
       fail(c, p + ".wall_margin_m", "must be a number >= 0 (metres)");
     if (!(g.height_m >= kSurfaceClearanceM && g.height_m <= s.size.y - kSurfaceClearanceM))
@@ -426,27 +453,33 @@ void validate_scene(const Scene& s, const std::string& origin) {
     check_headings(c, g.headings_deg, p + ".headings_deg");
     if (mic.kind == "grid") {
       if (2 * g.wall_margin_m > std::min(s.size.x, s.size.z))
-        fail(c, p + ".wall_margin_m", "a margin of " + fmt(g.wall_margin_m) +
-                                          " m leaves no floor area in a " + fmt(s.size.x) + " x " +
-                                          fmt(s.size.z) + " m room; reduce it");
+        fail(c, p + ".wall_margin_m",
+             "a margin of " + fmt(g.wall_margin_m) + " m leaves no floor area in a " +
+                 fmt(s.size.x) + " x " + fmt(s.size.z) + " m room; reduce it");
       const auto points = grid_microphone_positions(s);
       if (points.empty())
-        fail(c, p, "no grid point is in free space (all inside furniture); move furniture or change spacing_m");
+        fail(c, p,
+             "no grid point is in free space (all inside furniture); move furniture or change "
+             "spacing_m");
       if (points.size() > 1000000)
-        fail(c, p + ".spacing_m", "gives " + std::to_string(points.size()) + " points; use a larger spacing");
+        fail(c, p + ".spacing_m",
+             "gives " + std::to_string(points.size()) + " points; use a larger spacing");
     }
   }
   {
     const auto& r = mic.random;
     const std::string p = "microphones.random";
-    if (!(r.count >= 1 && r.count <= 1000000)) fail(c, p + ".count", "must be a whole number in [1, 1000000]");
+    if (!(r.count >= 1 && r.count <= 1000000))
+      fail(c, p + ".count", "must be a whole number in [1, 1000000]");
     if (!(r.wall_margin_m >= 0 && std::isfinite(r.wall_margin_m)))
       fail(c, p + ".wall_margin_m", "must be a number >= 0 (metres)");
     check_height_range(c, s, r.min_height_m, r.max_height_m, p);
     check_headings(c, r.headings_deg, p + ".headings_deg");
-    if (mic.kind == "random" && 2 * std::max(r.wall_margin_m, kSurfaceClearanceM) >= std::min(s.size.x, s.size.z))
-      fail(c, p + ".wall_margin_m", "a margin of " + fmt(r.wall_margin_m) + " m leaves no floor area in a " +
-                                        fmt(s.size.x) + " x " + fmt(s.size.z) + " m room; reduce it");
+    if (mic.kind == "random" &&
+        2 * std::max(r.wall_margin_m, kSurfaceClearanceM) >= std::min(s.size.x, s.size.z))
+      fail(c, p + ".wall_margin_m",
+           "a margin of " + fmt(r.wall_margin_m) + " m leaves no floor area in a " + fmt(s.size.x) +
+               " x " + fmt(s.size.z) + " m room; reduce it");
   }
 
   {
@@ -456,11 +489,14 @@ void validate_scene(const Scene& s, const std::string& origin) {
       fail(c, p + ".train_count", "must be a whole number in [1, 100000]");
     if (!(cam.eval_count >= 0 && cam.eval_count <= 100000))
       fail(c, p + ".eval_count", "must be a whole number in [0, 100000]");
-    if (!(cam.width >= 8 && cam.width <= 8192)) fail(c, p + ".width", "must be a whole number of pixels in [8, 8192]");
-    if (!(cam.height >= 8 && cam.height <= 8192)) fail(c, p + ".height", "must be a whole number of pixels in [8, 8192]");
+    if (!(cam.width >= 8 && cam.width <= 8192))
+      fail(c, p + ".width", "must be a whole number of pixels in [8, 8192]");
+    if (!(cam.height >= 8 && cam.height <= 8192))
+      fail(c, p + ".height", "must be a whole number of pixels in [8, 8192]");
     if (!(cam.fov_deg >= 10 && cam.fov_deg <= 170))
       fail(c, p + ".fov_deg", "must be a horizontal field of view in [10, 170] degrees");
-    if (!(cam.wall_margin_m >= 0 && 2 * std::max(cam.wall_margin_m, kSurfaceClearanceM) < std::min(s.size.x, s.size.z)))
+    if (!(cam.wall_margin_m >= 0 &&
+          2 * std::max(cam.wall_margin_m, kSurfaceClearanceM) < std::min(s.size.x, s.size.z)))
       fail(c, p + ".wall_margin_m", "must be >= 0 and leave floor area between the walls");
     if (!(cam.look_jitter_m >= 0 && std::isfinite(cam.look_jitter_m)))
       fail(c, p + ".look_jitter_m", "must be a number >= 0 (metres)");
@@ -470,13 +506,16 @@ void validate_scene(const Scene& s, const std::string& origin) {
   }
 
   check_point(s.light.position, "light.position", "light");
-  if (!(s.light.intensity >= 0 && std::isfinite(s.light.intensity))) fail(c, "light.intensity", "must be a number >= 0");
-  if (!(s.light.ambient >= 0 && std::isfinite(s.light.ambient))) fail(c, "light.ambient", "must be a number >= 0");
+  if (!(s.light.intensity >= 0 && std::isfinite(s.light.intensity)))
+    fail(c, "light.intensity", "must be a number >= 0");
+  if (!(s.light.ambient >= 0 && std::isfinite(s.light.ambient)))
+    fail(c, "light.ambient", "must be a number >= 0");
 
   const auto& ac = s.acoustics;
   if (!(ac.speed_of_sound > 0 && std::isfinite(ac.speed_of_sound)))
     fail(c, "acoustics.speed_of_sound", "must be a positive number (m/s)");
-  if (!(ac.max_order >= 0 && ac.max_order <= 100)) fail(c, "acoustics.max_order", "must be a whole number in [0, 100]");
+  if (!(ac.max_order >= 0 && ac.max_order <= 100))
+    fail(c, "acoustics.max_order", "must be a whole number in [0, 100]");
   if (!(ac.rir_length_s > 0 && ac.rir_length_s <= 20))
     fail(c, "acoustics.rir_length_s", "must be a number of seconds in (0, 20]");
 }
@@ -488,7 +527,10 @@ json scene_to_json(const Scene& s) {
   json mats = json::object();
   for (const auto& [name, m] : s.materials) {
     mats[name] = {{"albedo", vec_json(m.albedo)},
-                  {"texture", {{"kind", m.texture.kind}, {"scale_m", m.texture.scale_m}, {"contrast", m.texture.contrast}}},
+                  {"texture",
+                   {{"kind", m.texture.kind},
+                    {"scale_m", m.texture.scale_m},
+                    {"contrast", m.texture.contrast}}},
                   {"absorption", m.absorption},
                   {"scattering", m.scattering}};
   }
@@ -506,28 +548,39 @@ json scene_to_json(const Scene& s) {
   j["furniture"] = furniture;
   json sources = json::array();
   for (const auto& src : s.sources) {
-    sources.push_back({{"position", vec_json(src.position)}, {"yaw_deg", src.yaw_deg}, {"directivity", src.directivity}});
+    sources.push_back({{"position", vec_json(src.position)},
+                       {"yaw_deg", src.yaw_deg},
+                       {"directivity", src.directivity}});
   }
   j["sources"] = sources;
   const auto& g = s.microphones.grid;
   const auto& r = s.microphones.random;
-  j["microphones"] = {
-      {"kind", s.microphones.kind},
-      {"grid",
-       {{"spacing_m", g.spacing_m}, {"height_m", g.height_m}, {"wall_margin_m", g.wall_margin_m}, {"headings_deg", g.headings_deg}}},
-      {"random",
-       {{"count", r.count},
-        {"min_height_m", r.min_height_m},
-        {"max_height_m", r.max_height_m},
-        {"wall_margin_m", r.wall_margin_m},
-        {"headings_deg", r.headings_deg}}}};
+  j["microphones"] = {{"kind", s.microphones.kind},
+                      {"grid",
+                       {{"spacing_m", g.spacing_m},
+                        {"height_m", g.height_m},
+                        {"wall_margin_m", g.wall_margin_m},
+                        {"headings_deg", g.headings_deg}}},
+                      {"random",
+                       {{"count", r.count},
+                        {"min_height_m", r.min_height_m},
+                        {"max_height_m", r.max_height_m},
+                        {"wall_margin_m", r.wall_margin_m},
+                        {"headings_deg", r.headings_deg}}}};
   const auto& cam = s.cameras;
-  j["cameras"] = {{"train_count", cam.train_count},     {"eval_count", cam.eval_count},
-                  {"width", cam.width},                 {"height", cam.height},
-                  {"fov_deg", cam.fov_deg},             {"wall_margin_m", cam.wall_margin_m},
-                  {"look_jitter_m", cam.look_jitter_m}, {"min_height_m", cam.min_height_m},
-                  {"max_height_m", cam.max_height_m},   {"supersampling", cam.supersampling}};
-  j["light"] = {{"position", vec_json(s.light.position)}, {"intensity", s.light.intensity}, {"ambient", s.light.ambient}};
+  j["cameras"] = {{"train_count", cam.train_count},
+                  {"eval_count", cam.eval_count},
+                  {"width", cam.width},
+                  {"height", cam.height},
+                  {"fov_deg", cam.fov_deg},
+                  {"wall_margin_m", cam.wall_margin_m},
+                  {"look_jitter_m", cam.look_jitter_m},
+                  {"min_height_m", cam.min_height_m},
+                  {"max_height_m", cam.max_height_m},
+                  {"supersampling", cam.supersampling}};
+  j["light"] = {{"position", vec_json(s.light.position)},
+                {"intensity", s.light.intensity},
+                {"ambient", s.light.ambient}};
   j["acoustics"] = {{"speed_of_sound", s.acoustics.speed_of_sound},
                     {"max_order", s.acoustics.max_order},
                     {"rir_length_s", s.acoustics.rir_length_s}};

@@ -50,8 +50,10 @@ SynthPlan plan_synthesis(const Scene& scene, const std::string& layout, uint64_t
       }
     }
   }
-  plan.train_cameras = place_cameras(scene, scene.cameras.train_count, derive_seed(seed, "cameras-train"));
-  plan.eval_cameras = place_cameras(scene, scene.cameras.eval_count, derive_seed(seed, "cameras-eval"));
+  plan.train_cameras =
+      place_cameras(scene, scene.cameras.train_count, derive_seed(seed, "cameras-train"));
+  plan.eval_cameras =
+      place_cameras(scene, scene.cameras.eval_count, derive_seed(seed, "cameras-eval"));
   return plan;
 }
 

@@ -42,15 +42,18 @@ void prepare_out_dir(const std::string& dir, bool force) {
   if (fs::exists(dir, ec)) {
     require(fs::is_directory(dir, ec), dir + ": exists and is not a folder; choose another --out");
     const bool empty = fs::directory_iterator(dir, ec) == fs::directory_iterator();
-    require(empty || force, dir + ": the folder is not empty; choose a new or empty --out folder, or pass "
-                                  "--force to overwrite the files in it");
+    require(empty || force,
+            dir +
+                ": the folder is not empty; choose a new or empty --out folder, or pass "
+                "--force to overwrite the files in it");
   }
   fs::create_directories(dir, ec);
   require(!ec, dir + ": cannot create the folder (" + ec.message() + "); choose a writable --out");
 }
 
 // Runs body(i) for i in [0, n) on all OpenMP threads (dynamic schedule) with a progress bar drawn
-// by thread 0; rethrows the first exception after the loop (exceptions cannot leave OpenMP regions).
+// by thread 0; rethrows the first exception after the loop (exceptions cannot leave OpenMP
+// regions).
 template <typename Body>
 void parallel_for_with_progress(int64_t n, Progress* progress, Body body) {
   std::atomic<int64_t> done{0};
@@ -101,9 +104,11 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
   {
     std::vector<std::pair<const CameraView*, std::string>> shots;
     for (size_t i = 0; i < plan.train_cameras.size(); ++i)
-      shots.emplace_back(&plan.train_cameras[i], soundspaces ? frame_file_name("train_", int(i)) : "");
+      shots.emplace_back(&plan.train_cameras[i],
+                         soundspaces ? frame_file_name("train_", int(i)) : "");
     for (size_t i = 0; i < plan.eval_cameras.size(); ++i)
-      shots.emplace_back(&plan.eval_cameras[i], soundspaces ? frame_file_name("eval_", int(i)) : "");
+      shots.emplace_back(&plan.eval_cameras[i],
+                         soundspaces ? frame_file_name("eval_", int(i)) : "");
     if (!soundspaces) {  // RAF: one numbered sequence; the reader's 90 % fraction rule splits it
       for (size_t i = 0; i < shots.size(); ++i) shots[i].second = frame_file_name("", int(i));
     }
@@ -111,14 +116,16 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
     popt.unit = "img";
     Progress progress("images", static_cast<int64_t>(shots.size()), popt);
     for (size_t i = 0; i < shots.size(); ++i) {
-      const RgbImage img = renderer.render(*shots[i].first, scene.cameras.supersampling);  // OpenMP rows
+      const RgbImage img =
+          renderer.render(*shots[i].first, scene.cameras.supersampling);  // OpenMP rows
       write_png(out(shots[i].second), img);
       frames.push_back({shots[i].second, shots[i].first->pose});
       progress.update(static_cast<int64_t>(i + 1));
     }
     progress.finish();
     const CameraIntrinsics k = camera_intrinsics(scene.cameras);
-    io::write_json_atomically(out("transforms.json"), nerfstudio_transforms(k, frames, soundspaces));
+    io::write_json_atomically(out("transforms.json"),
+                              nerfstudio_transforms(k, frames, soundspaces));
     if (soundspaces) {
       sum.num_train_images = static_cast<int>(plan.train_cameras.size());
       sum.num_eval_images = static_cast<int>(plan.eval_cameras.size());
@@ -141,7 +148,8 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
   sim_options.seed = derive_seed(options.seed, "rir-tail");
   const RirSimulator simulator(scene, plan.sample_rate, hrtf.get(), sim_options);
   const auto render = [&](const RirJob& job) {
-    return simulator.render(scene.sources[job.source], plan.microphones[job.microphone], job.mic_yaw_deg);
+    return simulator.render(scene.sources[job.source], plan.microphones[job.microphone],
+                            job.mic_yaw_deg);
   };
   const auto peak_of = [](const std::vector<std::vector<float>>& channels) {
     double p = 0;
@@ -156,10 +164,13 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
     std::vector<size_t> order(plan.jobs.size());
     std::iota(order.begin(), order.end(), size_t{0});
     const auto dist = [&](size_t i) {
-      return norm(scene.sources[plan.jobs[i].source].position - plan.microphones[plan.jobs[i].microphone]);
+      return norm(scene.sources[plan.jobs[i].source].position -
+                  plan.microphones[plan.jobs[i].microphone]);
     };
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return dist(a) < dist(b); });
-    const size_t n_probe = std::min<size_t>(order.size(), 4 * std::max<size_t>(plan.headings_deg.size(), 1));
+    std::stable_sort(order.begin(), order.end(),
+                     [&](size_t a, size_t b) { return dist(a) < dist(b); });
+    const size_t n_probe =
+        std::min<size_t>(order.size(), 4 * std::max<size_t>(plan.headings_deg.size(), 1));
     std::vector<double> peaks(n_probe, 0.0);
     parallel_for_with_progress(static_cast<int64_t>(n_probe), nullptr,
                                [&](int64_t i) { peaks[i] = peak_of(render(plan.jobs[order[i]])); });
@@ -181,7 +192,8 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
       write_wav_float(out(job.file), channels, plan.sample_rate);
       if (!soundspaces) {
         const std::string dir = "data/" + job.name + "/";
-        io::write_text_atomically(out(dir + "rx_pos.txt"), raf_rx_pos(plan.microphones[job.microphone]));
+        io::write_text_atomically(out(dir + "rx_pos.txt"),
+                                  raf_rx_pos(plan.microphones[job.microphone]));
         const Source& src = scene.sources[job.source];
         io::write_text_atomically(out(dir + "tx_pos.txt"), raf_tx_pos(src.position, src.yaw_deg));
       }
@@ -191,7 +203,8 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
   sum.peak = peaks.empty() ? 0.0 : *std::max_element(peaks.begin(), peaks.end());
   if (sum.peak > 1.0) {
     const auto n_loud = std::count_if(peaks.begin(), peaks.end(), [](double p) { return p > 1.0; });
-    warn(std::to_string(n_loud) + " RIRs exceed 1.0 in amplitude (peak " + std::to_string(sum.peak) +
+    warn(std::to_string(n_loud) + " RIRs exceed 1.0 in amplitude (peak " +
+         std::to_string(sum.peak) +
          ") and will be clipped by NeRAF-style loaders; move sources away from the microphones");
   }
   sum.rir_seconds = seconds_since(t_rirs);

@@ -4,8 +4,8 @@
 //
 //   soundspaces (NeRAF's SoundSpaces layout, binaural 44.1 kHz)   raf (RAF layout, mono 48 kHz)
 //     scene.json, synth_info.json                                  scene.json, synth_info.json
-//     transforms.json + images/{train,eval}_frame_XXXXX.png        transforms.json + images/frame_XXXXX.png
-//     metadata/points.txt                                          data/<6-digit id>/rir.wav
+//     transforms.json + images/{train,eval}_frame_XXXXX.png        transforms.json +
+//     images/frame_XXXXX.png metadata/points.txt data/<6-digit id>/rir.wav
 //     metadata_AudioNeRF/split.json                                data/<id>/rx_pos.txt, tx_pos.txt
 //     binaural_rirs/<heading>/<r>_<s>.wav                          metadata/data-split.json
 //
@@ -30,11 +30,11 @@ struct SynthOptions {
 
 // One RIR file of the plan.
 struct RirJob {
-  std::string file;         // relative to out_dir: "binaural_rirs/90/12_3.wav", "data/000012/rir.wav"
-  std::string name;         // split entry: "90/12_3" (SoundSpaces), "000012" (RAF)
-  int source = 0;           // index into scene.sources
-  int microphone = 0;       // index into SynthPlan::microphones
-  double mic_yaw_deg = 0;   // receiver heading (SoundSpaces); 0 for RAF's omni microphones
+  std::string file;    // relative to out_dir: "binaural_rirs/90/12_3.wav", "data/000012/rir.wav"
+  std::string name;    // split entry: "90/12_3" (SoundSpaces), "000012" (RAF)
+  int source = 0;      // index into scene.sources
+  int microphone = 0;  // index into SynthPlan::microphones
+  double mic_yaw_deg = 0;  // receiver heading (SoundSpaces); 0 for RAF's omni microphones
 };
 
 struct SynthPlan {
@@ -57,15 +57,15 @@ struct SynthSummary {
   int num_microphones = 0, num_headings = 0, num_sources = 0;
   int64_t num_rirs = 0, num_train_rirs = 0, num_test_rirs = 0;
   int num_train_images = 0, num_eval_images = 0;
-  double gain = 1;        // one scene-wide factor applied to every RIR (see synthesize)
-  double peak = 0;        // largest |sample| written
+  double gain = 1;  // one scene-wide factor applied to every RIR (see synthesize)
+  double peak = 0;  // largest |sample| written
   double image_seconds = 0, rir_seconds = 0, total_seconds = 0;
 };
 
 // Writes the dataset. Refuses a non-empty out_dir unless options.force. Every RIR is scaled by one
 // scene-wide gain = min(1, 0.5 / peak of the closest source-microphone pairs) so no sample clips
-// in NeRAF's loaders (which clip to [-1, 1]) and relative levels stay physical; the gain is recorded
-// in synth_info.json.
+// in NeRAF's loaders (which clip to [-1, 1]) and relative levels stay physical; the gain is
+// recorded in synth_info.json.
 SynthSummary synthesize(const Scene& scene, const SynthOptions& options);
 
 }  // namespace neraf::sim
