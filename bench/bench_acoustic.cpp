@@ -7,11 +7,10 @@
 //   build-x/neraf_bench_acoustic --benchmark_filter=cpu
 // Without --benchmark_out the JSON goes to <repo>/bench/results/acoustic.json.
 #include <benchmark/benchmark.h>
+#include <torch/torch.h>
 
 #include <string>
 #include <vector>
-
-#include <torch/torch.h>
 
 #include "neraf/acoustic/acoustic_model.h"
 #include "neraf/acoustic/losses.h"
@@ -40,8 +39,8 @@ Batch make_batch(int64_t b) {
 }
 
 void set_label(benchmark::State& state, int64_t preset, bool bf16) {
-  state.SetLabel(std::string(preset_name(preset)) + (bf16 ? "/bf16" : "/fp32") + " threads=" +
-                 std::to_string(torch::get_num_threads()));
+  state.SetLabel(std::string(preset_name(preset)) + (bf16 ? "/bf16" : "/fp32") +
+                 " threads=" + std::to_string(torch::get_num_threads()));
 }
 
 // Full step without the optimiser: grid (requires grad, as the fresh cells do) → ResNet3D →
@@ -172,9 +171,12 @@ void BM_RenderStftCachedFeature(benchmark::State& state) {
 // cpu preset: many short runs; paper preset: seconds per iteration, so 1 iteration × 3 repetitions.
 #define NERAF_CPU(bm, ...) \
   BENCHMARK(bm)->Args({0, __VA_ARGS__})->Unit(benchmark::kMillisecond)->Repetitions(5)
-#define NERAF_PAPER(bm, ...)                                                                   \
-  BENCHMARK(bm)->Args({1, __VA_ARGS__})->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions( \
-      3)
+#define NERAF_PAPER(bm, ...)          \
+  BENCHMARK(bm)                       \
+      ->Args({1, __VA_ARGS__})        \
+      ->Unit(benchmark::kMillisecond) \
+      ->Iterations(1)                 \
+      ->Repetitions(3)
 
 NERAF_CPU(BM_AcousticStep, 0);
 NERAF_CPU(BM_AcousticStep, 1);
@@ -204,7 +206,8 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (std::string(argv[i]).rfind("--benchmark_out=", 0) == 0) has_out = true;
   }
-  std::string out = std::string("--benchmark_out=") + NERAF_ASSETS_DIR + "/../bench/results/acoustic.json";
+  std::string out =
+      std::string("--benchmark_out=") + NERAF_ASSETS_DIR + "/../bench/results/acoustic.json";
   std::string fmt = "--benchmark_out_format=json";
   if (!has_out) {
     args.push_back(out.data());

@@ -73,7 +73,11 @@ void BM_Gather(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * b);
   state.SetBytesProcessed(state.iterations() * b * 2 * 257 * 4);
 }
-BENCHMARK(BM_Gather)->Args({2048, 0})->Args({2048, 1})->Unit(benchmark::kMicrosecond)->UseRealTime();
+BENCHMARK(BM_Gather)
+    ->Args({2048, 0})
+    ->Args({2048, 1})
+    ->Unit(benchmark::kMicrosecond)
+    ->UseRealTime();
 
 void BM_Features(benchmark::State& state) {
   Fixture& f = fixture(false);

@@ -48,6 +48,8 @@ void BM_IstftRaf(benchmark::State& state) {
 }
 BENCHMARK(BM_IstftRaf)->Unit(benchmark::kMicrosecond);
 
+// Argument: GriffinLimOptions::threads (0 automatic: serial when the cores are already busy;
+// 1 serial; 2 forced two threads).
 void BM_GriffinLimRaf(benchmark::State& state) {  // 32 iterations on [513, 60]
   // 60 frames as in the RAF evaluation (the GT STFT truncated to max_len).
   const Matrix full = rir_magnitude(StftParams::raf(), 15360, 48000.0, 4);
@@ -57,9 +59,15 @@ void BM_GriffinLimRaf(benchmark::State& state) {  // 32 iterations on [513, 60]
   }
   neraf::dsp::GriffinLimOptions o;
   o.seed = 1;
+  o.threads = static_cast<int>(state.range(0));
   for (auto _ : state) benchmark::DoNotOptimize(neraf::dsp::griffin_lim(S, StftParams::raf(), o));
 }
-BENCHMARK(BM_GriffinLimRaf)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GriffinLimRaf)
+    ->ArgName("threads")
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond);
 
 void BM_GriffinLimSoundSpacesBinaural(benchmark::State& state) {  // 32 iterations on [2, 257, 100]
   std::vector<Matrix> S;
@@ -69,12 +77,17 @@ void BM_GriffinLimSoundSpacesBinaural(benchmark::State& state) {  // 32 iteratio
   }
   neraf::dsp::GriffinLimOptions o;
   o.seed = 1;
+  o.threads = static_cast<int>(state.range(0));
   for (auto _ : state) {
     benchmark::DoNotOptimize(neraf::dsp::griffin_lim(S, StftParams::soundspaces(), o));
   }
-  state.counters["frames"] = S[0].cols;
 }
-BENCHMARK(BM_GriffinLimSoundSpacesBinaural)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_GriffinLimSoundSpacesBinaural)
+    ->ArgName("threads")
+    ->Arg(0)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond);
 
 void BM_ConvolveRir1sAudio10s(benchmark::State& state) {  // 48 kHz
   const auto rir = random_signal(48000, 7);

@@ -118,14 +118,27 @@ void hash_reference_fwd_bwd(benchmark::State& state, const HashGridConfig& cfg, 
 #define NERAF_THREADS ->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()
 
 BENCHMARK_CAPTURE(hash_fwd_bwd, main_196k, main_grid(), 48, false)
-    ->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(hash_fwd_bwd, main_196k_with_grad_x, main_grid(), 48, true) NERAF_THREADS;
 BENCHMARK_CAPTURE(hash_fwd, main_196k, main_grid(), 48)
-    ->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(hash_bwd, main_196k, main_grid(), 48)
-    ->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(hash_reference_fwd_bwd, main_196k, main_grid(), 48)
-    ->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1)->Repetitions(3);
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1)
+    ->Repetitions(3);
 
 BENCHMARK_CAPTURE(hash_fwd_bwd, prop1_1048k, proposal_grid(128), 256, false) NERAF_THREADS;
 BENCHMARK_CAPTURE(hash_fwd, prop1_1048k, proposal_grid(128), 256) NERAF_THREADS;

@@ -51,8 +51,9 @@ TEST(AcousticModel, SampledForwardShapeAndGradientToGrid) {
   y.sum().backward();
   EXPECT_GT(grid.grad().abs().sum().item<float>(), 0.0f);
   // The scene feature is shared by the whole batch: same pose and frame → same output.
-  const auto one = m->forward(grid, b.t.slice(0, 0, 1).repeat({2}), b.mic.slice(0, 0, 1).repeat({2, 1}),
-                              b.src.slice(0, 0, 1).repeat({2, 1}), b.rot.slice(0, 0, 1).repeat({2, 1}));
+  const auto one =
+      m->forward(grid, b.t.slice(0, 0, 1).repeat({2}), b.mic.slice(0, 0, 1).repeat({2, 1}),
+                 b.src.slice(0, 0, 1).repeat({2, 1}), b.rot.slice(0, 0, 1).repeat({2, 1}));
   EXPECT_TRUE(torch::allclose(one[0], one[1]));
 }
 

@@ -1,13 +1,12 @@
 #include "neraf/acoustic/grid_sampler.h"
 
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <filesystem>
 #include <string>
-
-#include <unistd.h>
-
-#include <gtest/gtest.h>
-#include <torch/torch.h>
 
 namespace neraf::acoustic {
 namespace {
@@ -185,7 +184,7 @@ TEST(GridSampler, OnlyFreshCellsCarryGradient) {
 
   // Reference: the same loss restricted to the fresh cells, recomputed from the field directly.
   ToyField ref;
-  const auto u = grid_cell_centres(4, 20, 20);           // [20, 3]
+  const auto u = grid_cell_centres(4, 20, 20);  // [20, 3]
   const auto values = g->query_cells(
       [&ref](const torch::Tensor& a, const torch::Tensor& b) { return ref(a, b); }, u);  // [4, 20]
   const auto w_fresh = weights.slice(0, 0, 4).reshape({4, 64}).slice(1, 20, 40);
@@ -221,8 +220,8 @@ TEST(GridSampler, RefreshAllFillsEveryCellWithoutGrad) {
   EXPECT_EQ(field.calls, 7);
   EXPECT_FALSE(g->grid().requires_grad());
   const auto u = grid_cell_centres(4, 0, 64);
-  EXPECT_TRUE(torch::allclose(g->grid()[3].reshape({64}),
-                              1.0 - torch::exp(-1.0 * u.select(1, 0)), 1e-5, 1e-6));
+  EXPECT_TRUE(torch::allclose(g->grid()[3].reshape({64}), 1.0 - torch::exp(-1.0 * u.select(1, 0)),
+                              1e-5, 1e-6));
   EXPECT_EQ(g->pointer(), 0);
 }
 
@@ -251,9 +250,9 @@ TEST(GridSampler, StateRoundTripsThroughCheckpoint) {
   GridSampler g(o);
   ToyField field;
   g->update(as_fn(field));
-  const auto path =
-      (std::filesystem::temp_directory_path() / ("neraf_grid_" + std::to_string(::getpid()) + ".pt"))
-          .string();
+  const auto path = (std::filesystem::temp_directory_path() /
+                     ("neraf_grid_" + std::to_string(::getpid()) + ".pt"))
+                        .string();
   torch::save(g, path);
   GridSampler h(o);
   torch::load(h, path);

@@ -1,9 +1,9 @@
 #include "neraf/acoustic/losses.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
 #include <torch/torch.h>
+
+#include <cmath>
 
 namespace neraf::acoustic {
 namespace {
@@ -87,8 +87,7 @@ TEST(EnergyDecayLoss, SilentTailStaysFiniteAndDifferentiable) {
   EXPECT_TRUE(std::isfinite(l.item<double>()));
   l.backward();
   EXPECT_TRUE(torch::isfinite(pred.grad()).all().item<bool>());
-  EXPECT_THROW(energy_decay_loss(torch::zeros({2, 4, 5}), torch::zeros({2, 4, 5})),
-               std::exception);
+  EXPECT_THROW(energy_decay_loss(torch::zeros({2, 4, 5}), torch::zeros({2, 4, 5})), std::exception);
 }
 
 }  // namespace

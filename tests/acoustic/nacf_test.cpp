@@ -1,9 +1,9 @@
 #include "neraf/acoustic/nacf.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
 #include <torch/torch.h>
+
+#include <cmath>
 
 #include "neraf/acoustic/positional_encoding.h"
 

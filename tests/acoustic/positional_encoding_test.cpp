@@ -1,9 +1,9 @@
 #include "neraf/acoustic/positional_encoding.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
 #include <torch/torch.h>
+
+#include <cmath>
 
 namespace neraf::acoustic {
 namespace {
@@ -65,9 +65,9 @@ TEST(NerfEncoding, TimeAnchorsAndBatchShape) {
     EXPECT_NEAR(out[0][k].item<float>(), 0.0f, 1e-6);       // sin(0)
     EXPECT_NEAR(out[0][10 + k].item<float>(), 1.0f, 1e-6);  // cos(0)
   }
-  EXPECT_NEAR(out[1][0].item<float>(), 1.0f, 1e-6);    // sin(2π·0.25·1) = 1
-  EXPECT_NEAR(out[1][10].item<float>(), 0.0f, 1e-6);   // cos(π/2) = 0
-  EXPECT_NEAR(out[1][9].item<float>(), 0.0f, 1e-4);    // sin(2π·0.25·256) = sin(128π) = 0
+  EXPECT_NEAR(out[1][0].item<float>(), 1.0f, 1e-6);   // sin(2π·0.25·1) = 1
+  EXPECT_NEAR(out[1][10].item<float>(), 0.0f, 1e-6);  // cos(π/2) = 0
+  EXPECT_NEAR(out[1][9].item<float>(), 0.0f, 1e-4);   // sin(2π·0.25·256) = sin(128π) = 0
   EXPECT_NEAR(out[1][19].item<float>(), 1.0f, 1e-4);
   EXPECT_EQ(out[1][20].item<float>(), 0.25f);
 }

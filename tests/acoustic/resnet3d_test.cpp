@@ -1,10 +1,10 @@
 #include "neraf/acoustic/resnet3d.h"
 
-#include <cmath>
-#include <string>
-
 #include <gtest/gtest.h>
 #include <torch/torch.h>
+
+#include <cmath>
+#include <string>
 
 namespace neraf::acoustic {
 namespace {
@@ -16,8 +16,8 @@ int64_t count_parameters(torch::nn::Module& m) {
 }
 
 // Independent arithmetic for a bottleneck ResNet3D (no biases in convs; BN has weight + bias).
-int64_t bottleneck_resnet_params(int64_t in_ch, int64_t stem, int64_t k, std::vector<int64_t> layers,
-                                 std::vector<int64_t> planes) {
+int64_t bottleneck_resnet_params(int64_t in_ch, int64_t stem, int64_t k,
+                                 std::vector<int64_t> layers, std::vector<int64_t> planes) {
   auto bn = [](int64_t c) { return 2 * c; };
   int64_t n = in_ch * stem * k * k * k + bn(stem);
   int64_t in = stem;

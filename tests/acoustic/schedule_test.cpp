@@ -1,9 +1,9 @@
 #include "neraf/acoustic/schedule.h"
 
-#include <cmath>
-
 #include <gtest/gtest.h>
 #include <torch/torch.h>
+
+#include <cmath>
 
 namespace neraf::acoustic {
 namespace {

@@ -48,18 +48,19 @@ TEST(Quaternion, UnnormalisedInputIsNormalisedLikeScipy) {
 
 TEST(Quaternion, ExtrinsicYxzOfACompositeRotation) {
   // R = Rz(10°)·Rx(20°)·Ry(30°) (extrinsic y, then x, then z) -> angles (30, 20, 10).
-  const Quaternion q = geometry::multiply(
-      geometry::axis_angle(0, 0, 1, 10 * kDeg),
-      geometry::multiply(geometry::axis_angle(1, 0, 0, 20 * kDeg), geometry::axis_angle(0, 1, 0, 30 * kDeg)));
+  const Quaternion q =
+      geometry::multiply(geometry::axis_angle(0, 0, 1, 10 * kDeg),
+                         geometry::multiply(geometry::axis_angle(1, 0, 0, 20 * kDeg),
+                                            geometry::axis_angle(0, 1, 0, 30 * kDeg)));
   const auto e = geometry::euler_yxz_deg(geometry::quaternion_to_matrix(q));
   EXPECT_NEAR(e[0], 30, 1e-9);
   EXPECT_NEAR(e[1], 20, 1e-9);
   EXPECT_NEAR(e[2], 10, 1e-9);
   // Negative pitch and a yaw beyond 90°: (−150, −40, 75).
-  const Quaternion q2 = geometry::multiply(
-      geometry::axis_angle(0, 0, 1, 75 * kDeg),
-      geometry::multiply(geometry::axis_angle(1, 0, 0, -40 * kDeg),
-                         geometry::axis_angle(0, 1, 0, -150 * kDeg)));
+  const Quaternion q2 =
+      geometry::multiply(geometry::axis_angle(0, 0, 1, 75 * kDeg),
+                         geometry::multiply(geometry::axis_angle(1, 0, 0, -40 * kDeg),
+                                            geometry::axis_angle(0, 1, 0, -150 * kDeg)));
   const auto e2 = geometry::euler_yxz_deg(geometry::quaternion_to_matrix(q2));
   EXPECT_NEAR(e2[0], -150, 1e-9);
   EXPECT_NEAR(e2[1], -40, 1e-9);
@@ -68,8 +69,8 @@ TEST(Quaternion, ExtrinsicYxzOfACompositeRotation) {
 
 TEST(Quaternion, GimbalLockSetsTheThirdAngleToZero) {
   // Rx(90°)·Ry(25°): β = 90°, scipy reports (25, 90, 0).
-  const Quaternion q =
-      geometry::multiply(geometry::axis_angle(1, 0, 0, 90 * kDeg), geometry::axis_angle(0, 1, 0, 25 * kDeg));
+  const Quaternion q = geometry::multiply(geometry::axis_angle(1, 0, 0, 90 * kDeg),
+                                          geometry::axis_angle(0, 1, 0, 25 * kDeg));
   const auto e = geometry::euler_yxz_deg(geometry::quaternion_to_matrix(q));
   EXPECT_NEAR(e[0], 25, 1e-6);
   EXPECT_NEAR(e[1], 90, 1e-6);
@@ -77,7 +78,8 @@ TEST(Quaternion, GimbalLockSetsTheThirdAngleToZero) {
 }
 
 TEST(Quaternion, MatrixQuaternionRoundTrip) {
-  const Quaternion q = geometry::multiply(geometry::axis_angle(1, 2, 3, 2.0), geometry::axis_angle(0, 0, 1, 1.0));
+  const Quaternion q =
+      geometry::multiply(geometry::axis_angle(1, 2, 3, 2.0), geometry::axis_angle(0, 0, 1, 1.0));
   const Quaternion back = geometry::matrix_to_quaternion(geometry::quaternion_to_matrix(q));
   const double sign = (back.w * q.w >= 0) ? 1.0 : -1.0;
   EXPECT_NEAR(back.x, sign * q.x, 1e-12);
@@ -124,12 +126,12 @@ TEST(Encoding, PositionNormalisationZeroesTheWholeVectorOutsideTheOpenBox) {
     EXPECT_EQ(z.y, 0.0);
     EXPECT_EQ(z.z, 0.0);
   }
-  const torch::Tensor pts = torch::tensor({1.0, 0.5, 5.0, 1.0, 0.5, 7.0, 2.0, 1.0, 3.0}, torch::kFloat64)
-                                .view({3, 3});
+  const torch::Tensor pts =
+      torch::tensor({1.0, 0.5, 5.0, 1.0, 0.5, 7.0, 2.0, 1.0, 3.0}, torch::kFloat64).view({3, 3});
   const torch::Tensor n = data::normalize_position(pts, box);
-  const torch::Tensor want = torch::tensor({0.5, 0.25, 0.75, 0.0, 0.0, 0.0, 0.75, 0.5, 0.25},
-                                           torch::kFloat64)
-                                 .view({3, 3});
+  const torch::Tensor want =
+      torch::tensor({0.5, 0.25, 0.75, 0.0, 0.0, 0.0, 0.75, 0.5, 0.25}, torch::kFloat64)
+          .view({3, 3});
   EXPECT_TRUE(torch::allclose(n, want, 0, 1e-15)) << n;
 }
 

@@ -114,8 +114,8 @@ struct SoundSpacesScene {
     int64_t samples;
     bool train;
   };
-  std::vector<std::array<double, 3>> points{{1.0, 1.5, 2.0}, {-0.5, 1.5, 0.25}, {2.5, 1.2, -1.0},
-                                            {0.0, 1.8, 3.0}};
+  std::vector<std::array<double, 3>> points{
+      {1.0, 1.5, 2.0}, {-0.5, 1.5, 0.25}, {2.5, 1.2, -1.0}, {0.0, 1.8, 3.0}};
   std::vector<Entry> entries{{0, 0, 1, 20001, true},   {90, 1, 2, 3000, true},
                              {180, 2, 3, 12345, true}, {270, 3, 0, 4410, true},
                              {0, 2, 1, 9001, true},    {90, 0, 3, 15000, false},
@@ -183,7 +183,9 @@ struct RafRoom {
     std::snprintf(buf, sizeof buf, "%06zu", i);
     return buf;
   }
-  std::vector<float> audio(size_t i) const { return decaying_noise(72000, 48000, 0.5, 500 + i, 0.01f); }
+  std::vector<float> audio(size_t i) const {
+    return decaying_noise(72000, 48000, 0.5, 500 + i, 0.01f);
+  }
 
   void write(const std::string& dir) const {
     for (size_t i = 0; i < entries.size(); ++i) {
@@ -236,14 +238,15 @@ struct NerfstudioScene {
       std::snprintf(m, sizeof m,
                     "[[%.17g, %.17g, %.17g, %.17g], [%.17g, %.17g, %.17g, %.17g], "
                     "[%.17g, %.17g, %.17g, %.17g], [0, 0, 0, 1]]",
-                    p[0][0], p[0][1], p[0][2], p[0][3], p[1][0], p[1][1], p[1][2], p[1][3],
-                    p[2][0], p[2][1], p[2][2], p[2][3]);
+                    p[0][0], p[0][1], p[0][2], p[0][3], p[1][0], p[1][1], p[1][2], p[1][3], p[2][0],
+                    p[2][1], p[2][2], p[2][3]);
       frames += std::string(i ? ", " : "") + "{\"file_path\": \"" + names[i] +
                 "\", \"transform_matrix\": " + m + "}";
     }
-    return "{\"camera_model\": \"OPENCV\", " + extra_top_level + " \"fl_x\": 10.0, \"fl_y\": 11.0, " +
-           "\"cx\": 6.0, \"cy\": 4.0, \"w\": " + std::to_string(width) + ", \"h\": " +
-           std::to_string(height) + ", \"k1\": 0.01, \"frames\": [" + frames + "]}";
+    return "{\"camera_model\": \"OPENCV\", " + extra_top_level +
+           " \"fl_x\": 10.0, \"fl_y\": 11.0, " +
+           "\"cx\": 6.0, \"cy\": 4.0, \"w\": " + std::to_string(width) +
+           ", \"h\": " + std::to_string(height) + ", \"k1\": 0.01, \"frames\": [" + frames + "]}";
   }
   void write(const std::string& dir) const {
     for (size_t i = 0; i < names.size(); ++i) write_image(dir, i, width, height);

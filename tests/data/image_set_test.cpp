@@ -1,11 +1,12 @@
 // nerfstudio transforms.json loading: splits, intrinsics, pixels, pose normalisation (nerfstudio
 // dataparser semantics) and the errors that name the frame.
+#include "neraf/data/image_set.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "fixtures.h"
-#include "neraf/data/image_set.h"
 #include "neraf/util/error.h"
 
 namespace fs = std::filesystem;
@@ -101,16 +102,20 @@ TEST(ImageSet, PoseNormalisationMatchesNerfstudio) {
   o.train_fraction = 1.0;
   const ImageSet set = load_transforms_json(dir.path(), o);
   ASSERT_EQ(set.train.size(), 2);
-  const torch::Tensor want0 = torch::tensor({1.f, 0.f, 0.f, -1.f, 0.f, 0.f, -1.f, 0.f, 0.f, 1.f, 0.f, 0.f}).view({3, 4});
-  const torch::Tensor want1 = torch::tensor({1.f, 0.f, 0.f, 1.f, 0.f, 0.f, -1.f, 0.f, 0.f, 1.f, 0.f, 0.f}).view({3, 4});
-  EXPECT_TRUE(torch::allclose(set.train.camera_to_world[0], want0, 0, 1e-6)) << set.train.camera_to_world;
+  const torch::Tensor want0 =
+      torch::tensor({1.f, 0.f, 0.f, -1.f, 0.f, 0.f, -1.f, 0.f, 0.f, 1.f, 0.f, 0.f}).view({3, 4});
+  const torch::Tensor want1 =
+      torch::tensor({1.f, 0.f, 0.f, 1.f, 0.f, 0.f, -1.f, 0.f, 0.f, 1.f, 0.f, 0.f}).view({3, 4});
+  EXPECT_TRUE(torch::allclose(set.train.camera_to_world[0], want0, 0, 1e-6))
+      << set.train.camera_to_world;
   EXPECT_TRUE(torch::allclose(set.train.camera_to_world[1], want1, 0, 1e-6));
   EXPECT_DOUBLE_EQ(set.world_scale, 1.0);
   // The stored transform maps dataset points the same way: (3,0,0) -> (1,0,0), (2,5,0) -> (0,0,5).
-  const torch::Tensor p = torch::tensor({3.0, 0.0, 0.0, 2.0, 5.0, 0.0}, torch::kFloat64).view({2, 3});
+  const torch::Tensor p =
+      torch::tensor({3.0, 0.0, 0.0, 2.0, 5.0, 0.0}, torch::kFloat64).view({2, 3});
   const torch::Tensor q = to_normalized_world(set, p);
-  EXPECT_TRUE(torch::allclose(q, torch::tensor({1.0, 0.0, 0.0, 0.0, 0.0, 5.0}, torch::kFloat64).view({2, 3}),
-                              0, 1e-12))
+  EXPECT_TRUE(torch::allclose(
+      q, torch::tensor({1.0, 0.0, 0.0, 0.0, 0.0, 5.0}, torch::kFloat64).view({2, 3}), 0, 1e-12))
       << q;
 }
 
@@ -122,19 +127,23 @@ TEST(ImageSet, OrientationOverrideNoneAndAutoScale) {
   const ImageSet set = load_transforms_json(dir.path(), quiet());
   // No rotation: R = I; translation −mean; scale 1 / max |t|.
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) EXPECT_DOUBLE_EQ(set.world_transform[i][j].item<double>(), i == j ? 1.0 : 0.0);
+    for (int j = 0; j < 3; ++j)
+      EXPECT_DOUBLE_EQ(set.world_transform[i][j].item<double>(), i == j ? 1.0 : 0.0);
   double mean[3] = {0, 0, 0};
   for (size_t f = 0; f < 4; ++f)
     for (int r = 0; r < 3; ++r) mean[r] += NerfstudioScene::pose(f)[r][3] / 4;
   double max_abs = 0;
   for (size_t f = 0; f < 4; ++f)
-    for (int r = 0; r < 3; ++r) max_abs = std::max(max_abs, std::abs(NerfstudioScene::pose(f)[r][3] - mean[r]));
+    for (int r = 0; r < 3; ++r)
+      max_abs = std::max(max_abs, std::abs(NerfstudioScene::pose(f)[r][3] - mean[r]));
   EXPECT_NEAR(set.world_scale, 1.0 / max_abs, 1e-12);
   // Frame 3 (train_0002, the last train frame after sorting): rotation unchanged, t normalised.
   const auto p3 = NerfstudioScene::pose(3);
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(set.train.camera_to_world[2][r][c].item<float>(), p3[r][c], 1e-6);
-    EXPECT_NEAR(set.train.camera_to_world[2][r][3].item<float>(), (p3[r][3] - mean[r]) / max_abs, 1e-6);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(set.train.camera_to_world[2][r][c].item<float>(), p3[r][c], 1e-6);
+    EXPECT_NEAR(set.train.camera_to_world[2][r][3].item<float>(), (p3[r][3] - mean[r]) / max_abs,
+                1e-6);
   }
   // All normalised translations within [-1, 1], one of them at ±1.
   const torch::Tensor t = torch::cat({set.train.camera_to_world, set.eval.camera_to_world})
@@ -209,7 +218,8 @@ TEST(ImageSet, ErrorsNameTheFrameAndFile) {
     EXPECT_NE(problems.items()[0].what.find("frames[0]"), std::string::npos);
     EXPECT_NE(problems.items()[0].what.find("not a rotation"), std::string::npos);
     EXPECT_NE(problems.items()[1].what.find("frames[1]"), std::string::npos);
-    EXPECT_NE(problems.items()[1].what.find("det -1"), std::string::npos) << problems.items()[1].what;
+    EXPECT_NE(problems.items()[1].what.find("det -1"), std::string::npos)
+        << problems.items()[1].what;
   }
   {  // empty train split: every file is an eval_ frame
     TempDir dir;
@@ -244,9 +254,10 @@ TEST(ImageSet, RafSizedFractionSplitCounts) {
       frames += std::string(i ? "," : "") +
                 R"({"file_path": "images/frame_00000.png", "transform_matrix": [[1,0,0,)" +
                 std::to_string(i) + "],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}";
-    testing::write_text(dir / "transforms.json",
-                        R"({"fl_x": 10, "fl_y": 10, "cx": 6, "cy": 4, "w": 12, "h": 8, "frames": [)" +
-                            frames + "]}");
+    testing::write_text(
+        dir / "transforms.json",
+        R"({"fl_x": 10, "fl_y": 10, "cx": 6, "cy": 4, "w": 12, "h": 8, "frames": [)" + frames +
+            "]}");
     ImageLoadOptions o = quiet();
     o.load_pixels = false;
     const ImageSet set = load_transforms_json(dir.path(), o);

@@ -1,6 +1,8 @@
 // RirSet loaders on tiny datasets written in the real SoundSpaces and RAF layouts: poses, headings,
 // splits, features against a direct dsp computation of the reference recipe, padding, max_len,
 // the feature cache (reuse, invalidation) and the training-batch gather.
+#include "neraf/data/rir_set.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,7 +11,6 @@
 
 #include "fixtures.h"
 #include "neraf/data/rir_layouts.h"
-#include "neraf/data/rir_set.h"
 #include "neraf/dsp/resample.h"
 #include "neraf/dsp/stft.h"
 #include "neraf/util/error.h"
@@ -36,7 +37,8 @@ std::vector<float> clip(std::vector<float> x) {
 
 // The process_audio.ipynb recipe written out with dsp calls: [C, F, T] log-magnitudes (unpadded)
 // and the minimum magnitude.
-torch::Tensor soundspaces_reference(const std::vector<std::vector<float>>& channels, float* min_mag) {
+torch::Tensor soundspaces_reference(const std::vector<std::vector<float>>& channels,
+                                    float* min_mag) {
   std::vector<torch::Tensor> out;
   *min_mag = 1e30f;
   for (const auto& ch : channels) {
@@ -198,8 +200,9 @@ TEST(SoundSpaces, PublishedMagnitudeFilesAreUsedWhenPresent) {
     torch::Tensor m = torch::rand({2, 257, t}) * 3 + 1e-4;
     mags.push_back(m);
     std::vector<float> v(m.data_ptr<float>(), m.data_ptr<float>() + m.numel());
-    testing::write_npy(dir / ("binaural_magnitudes_sr22050/" + SoundSpacesScene::key(scene.entries[i]) + ".npy"),
-                       {2, 257, t}, v);
+    testing::write_npy(
+        dir / ("binaural_magnitudes_sr22050/" + SoundSpacesScene::key(scene.entries[i]) + ".npy"),
+        {2, 257, t}, v);
   }
   const RirSet set = load_soundspaces(dir.path(), quiet());
   EXPECT_EQ(set.max_len, 20 + 7 * 6);  // the longest magnitude file
@@ -240,7 +243,8 @@ TEST(SoundSpaces, SplitAtSceneRootIsAcceptedAndMissingSplitIsAnError) {
     load_soundspaces(dir.path(), o);
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("metadata_AudioNeRF/split.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("metadata_AudioNeRF/split.json"), std::string::npos)
+        << e.what();
   }
 }
 
@@ -320,7 +324,8 @@ TEST(FeatureCache, GatherReturnsTheRequestedSlices) {
   torch::Tensor out = torch::empty({b, 2, 257});
   set.gather_into(rir.to(torch::kInt32), frame, out);
   EXPECT_TRUE(torch::equal(out, g));
-  EXPECT_THROW(set.gather(torch::tensor({int64_t(set.size())}), torch::tensor({int64_t(0)})), c10::Error);
+  EXPECT_THROW(set.gather(torch::tensor({int64_t(set.size())}), torch::tensor({int64_t(0)})),
+               c10::Error);
   EXPECT_THROW(set.gather(torch::tensor({int64_t(0)}), torch::tensor({set.max_len})), c10::Error);
 }
 

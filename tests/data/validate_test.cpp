@@ -27,9 +27,11 @@ std::vector<Problem> errors(const std::vector<Problem>& all) {
 }
 
 // Exactly one error, whose file contains `file_part` and whose text contains `what_part`.
-void expect_one_error(const std::string& dir, const std::string& file_part, const std::string& what_part) {
+void expect_one_error(const std::string& dir, const std::string& file_part,
+                      const std::string& what_part) {
   const auto e = errors(validate_dataset(dir));
-  ASSERT_EQ(e.size(), 1u) << (e.empty() ? "no error" : e[0].to_string() + " ... " + e.back().to_string());
+  ASSERT_EQ(e.size(), 1u) << (e.empty() ? "no error"
+                                        : e[0].to_string() + " ... " + e.back().to_string());
   EXPECT_NE(e[0].to_string().find(file_part), std::string::npos) << e[0].to_string();
   EXPECT_NE(e[0].to_string().find(what_part), std::string::npos) << e[0].to_string();
   EXPECT_FALSE(e[0].fix.empty());
@@ -102,12 +104,14 @@ TEST(Validate, MissingWav) {
 TEST(Validate, WrongSampleRate) {
   SoundSpacesWithImages ss;
   testing::write_wav(ss.audio.wav(ss.dir.path(), ss.audio.entries[0]), 48000, ss.audio.audio(0));
-  expect_one_error(ss.dir.path(), "binaural_rirs/0/0_1.wav", "sample rate 48000 Hz, expected 44100 Hz");
+  expect_one_error(ss.dir.path(), "binaural_rirs/0/0_1.wav",
+                   "sample rate 48000 Hz, expected 44100 Hz");
 }
 
 TEST(Validate, WrongChannelCount) {
   SoundSpacesWithImages ss;
-  testing::write_wav(ss.audio.wav(ss.dir.path(), ss.audio.entries[1]), 44100, {ss.audio.audio(1)[0]});
+  testing::write_wav(ss.audio.wav(ss.dir.path(), ss.audio.entries[1]), 44100,
+                     {ss.audio.audio(1)[0]});
   expect_one_error(ss.dir.path(), "binaural_rirs/90/1_2.wav", "1 channel(s), expected 2");
   TempDir raf;
   RafRoom room;
@@ -167,7 +171,8 @@ TEST(Validate, DuplicateIds) {
   TempDir raf;
   RafRoom room;
   room.write(raf.path());
-  testing::write_text(raf / "metadata/data-split.json", R"({"train": [[0, 1, 2, 3]], "test": [[4, 5, 1]]})");
+  testing::write_text(raf / "metadata/data-split.json",
+                      R"({"train": [[0, 1, 2, 3]], "test": [[4, 5, 1]]})");
   expect_one_error(raf.path(), "data-split.json", "\"000001\" is listed twice");
 }
 
@@ -180,7 +185,8 @@ TEST(Validate, ImageListedButAbsent) {
 TEST(Validate, ImageSizeDiffersFromIntrinsics) {
   SoundSpacesWithImages ss;
   ss.images.write_image(ss.dir.path(), 3, 12, 9);
-  expect_one_error(ss.dir.path(), "transforms.json", "frames[3] (images/train_0002.png): image is 12x9");
+  expect_one_error(ss.dir.path(), "transforms.json",
+                   "frames[3] (images/train_0002.png): image is 12x9");
 }
 
 TEST(Validate, UnreadableAudioAndBadMagnitudeFile) {
@@ -191,7 +197,8 @@ TEST(Validate, UnreadableAudioAndBadMagnitudeFile) {
   SoundSpacesWithImages ss2;
   for (size_t i = 0; i < ss2.audio.entries.size(); ++i) {
     const int64_t c = i == 5 ? 1 : 2;  // entry 5 has one channel too few
-    testing::write_npy(ss2.dir / ("binaural_magnitudes_sr22050/" + SoundSpacesScene::key(ss2.audio.entries[i]) + ".npy"),
+    testing::write_npy(ss2.dir / ("binaural_magnitudes_sr22050/" +
+                                  SoundSpacesScene::key(ss2.audio.entries[i]) + ".npy"),
                        {c, 257, 4}, std::vector<float>(c * 257 * 4, 1.0f));
   }
   expect_one_error(ss2.dir.path(), "binaural_magnitudes_sr22050/90/0_3.npy", "shape [2, 257, T]");

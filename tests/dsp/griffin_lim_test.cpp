@@ -1,7 +1,6 @@
 #include "neraf/dsp/griffin_lim.h"
 
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <cmath>
 #include <random>
@@ -145,11 +144,12 @@ TEST(GriffinLim, DeterministicPerSeedAndThreadCount) {
   const auto a = neraf::dsp::griffin_lim(S, p, o);
   const auto b = neraf::dsp::griffin_lim(S, p, o);
   EXPECT_EQ(a, b);
-  const int threads = omp_get_max_threads();
-  omp_set_num_threads(1);
-  const auto c = neraf::dsp::griffin_lim(S, p, o);
-  omp_set_num_threads(threads);
-  EXPECT_EQ(a, c) << "results must not depend on the thread count";
+  for (int threads :
+       {1, 2, 3}) {  // serial, and frames shared by a team (forced, whatever the load)
+    o.threads = threads;
+    EXPECT_EQ(a, neraf::dsp::griffin_lim(S, p, o)) << threads << " threads";
+  }
+  o.threads = 0;
   o.seed = 43;
   const auto d = neraf::dsp::griffin_lim(S, p, o);
   EXPECT_GT(max_abs_diff(a, d), 1e-3 * max_abs(a)) << "different seeds give different phases";
@@ -180,12 +180,11 @@ TEST(GriffinLim, MultichannelMatchesPerChannelRandomStream) {
   const auto r_alone = neraf::dsp::griffin_lim(R, p, o);
   EXPECT_GT(max_abs_diff(both[1], r_alone), 1e-4 * max_abs(r_alone));
   EXPECT_LT(spectral_convergence(both[1], R, p), 0.12);
-  // Same result with one thread.
-  const int threads = omp_get_max_threads();
-  omp_set_num_threads(1);
-  const auto one = neraf::dsp::griffin_lim(std::vector<Matrix>{L, R}, p, o);
-  omp_set_num_threads(threads);
-  EXPECT_EQ(both, one);
+  // Same result serially, with a channel per thread (2) and with frames shared by a team (3).
+  for (int threads : {1, 2, 3}) {
+    o.threads = threads;
+    EXPECT_EQ(both, neraf::dsp::griffin_lim(std::vector<Matrix>{L, R}, p, o)) << threads;
+  }
 }
 
 TEST(GriffinLim, LengthOption) {
@@ -212,6 +211,9 @@ TEST(GriffinLim, RejectsBadInput) {
   nan(3, 4) = std::nanf("");
   EXPECT_THROW(neraf::dsp::griffin_lim(nan, p), neraf::Error);
   GriffinLimOptions o;
+  o.threads = -1;
+  EXPECT_THROW(neraf::dsp::griffin_lim(Matrix(513, 10, 1.0f), p, o), neraf::Error);
+  o.threads = 0;
   o.momentum = 1.0f;
   EXPECT_THROW(neraf::dsp::griffin_lim(Matrix(513, 10, 1.0f), p, o), neraf::Error);
   EXPECT_THROW(neraf::dsp::griffin_lim(std::vector<Matrix>{Matrix(513, 10), Matrix(513, 11)}, p),

@@ -1,6 +1,7 @@
 #include "neraf/dsp/stft.h"
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <cmath>
 #include <complex>
@@ -203,6 +204,25 @@ TEST(Stft, IstftMatchesDirectOverlapAdd) {
     max_err = std::max(max_err, std::abs(ref - y[i]));
   }
   EXPECT_LT(max_err, 1e-5 * max_ref);
+}
+
+TEST(Stft, LongSignalsGiveTheSameNumbersWithAnyThreadCount) {
+  // Long enough for the parallel path (≥ 2^18 samples of frame work).
+  const auto x = random_signal(48000 * 6, 8);
+  for (const StftParams& p : {StftParams::soundspaces(), StftParams::raf()}) {
+    const auto S = neraf::dsp::stft(x, p);
+    const auto y = neraf::dsp::istft(S, p, x.size());
+    const int threads = omp_get_max_threads();
+    omp_set_num_threads(1);
+    const auto S1 = neraf::dsp::stft(x, p);
+    const auto y1 = neraf::dsp::istft(S, p, x.size());
+    omp_set_num_threads(threads);
+    EXPECT_EQ(S.data, S1.data);
+    EXPECT_EQ(y, y1);
+    double err = 0.0;
+    for (size_t i = 0; i < x.size(); ++i) err = std::max(err, double(std::abs(y[i] - x[i])));
+    EXPECT_LT(err, 1e-5);
+  }
 }
 
 TEST(Stft, LogMagnitude) {

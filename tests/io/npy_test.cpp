@@ -56,8 +56,9 @@ class NpyTest : public ::testing::Test {
 TEST_F(NpyTest, ReadsFloat32ThreeDimensional) {
   std::vector<float> v(2 * 3 * 4);
   for (size_t i = 0; i < v.size(); ++i) v[i] = 0.5f * i - 3.0f;
-  const std::string p = write("a.npy", "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3, 4), }",
-                              v.data(), v.size() * 4);
+  const std::string p =
+      write("a.npy", "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3, 4), }", v.data(),
+            v.size() * 4);
   const NpyHeader h = read_npy_header(p);
   EXPECT_EQ(h.shape, (std::vector<int64_t>{2, 3, 4}));
   EXPECT_EQ(h.element_size, 4);
@@ -78,8 +79,8 @@ TEST_F(NpyTest, ConvertsFloat64AndReadsVersion2And1D) {
 
 TEST_F(NpyTest, ScalarAndEmptyArrays) {
   const float one = 4.0f;
-  const NpyArray s = read_npy(
-      write("s.npy", "{'descr': '<f4', 'fortran_order': False, 'shape': (), }", &one, 4));
+  const NpyArray s =
+      read_npy(write("s.npy", "{'descr': '<f4', 'fortran_order': False, 'shape': (), }", &one, 4));
   EXPECT_TRUE(s.shape.empty());
   ASSERT_EQ(s.data.size(), 1u);
   EXPECT_EQ(s.data[0], 4.0f);
@@ -105,7 +106,8 @@ TEST_F(NpyTest, RejectsWhatItCannotReadWithClearErrors) {
   expect_error_naming(
       write("be.npy", "{'descr': '>f4', 'fortran_order': False, 'shape': (4,), }", v, 16), "'>f4'");
   expect_error_naming(
-      write("int.npy", "{'descr': '<i4', 'fortran_order': False, 'shape': (4,), }", v, 16), "'<i4'");
+      write("int.npy", "{'descr': '<i4', 'fortran_order': False, 'shape': (4,), }", v, 16),
+      "'<i4'");
   expect_error_naming(
       write("f.npy", "{'descr': '<f4', 'fortran_order': True, 'shape': (2, 2), }", v, 16),
       "Fortran order");

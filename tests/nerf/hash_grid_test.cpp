@@ -7,8 +7,8 @@
 #include <torch/torch.h>
 
 #include <cmath>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <vector>
 
 #include "neraf/util/error.h"
@@ -69,9 +69,8 @@ Expected expected_layout(int L, int log2_t, int base, int max_res) {
 
 void expect_layout_matches(const HashGridConfig& cfg) {
   const HashGridLayout layout = HashGridLayout::make(cfg);
-  const Expected e =
-      expected_layout(cfg.num_levels, cfg.log2_hashmap_size, cfg.base_resolution,
-                      cfg.max_resolution);
+  const Expected e = expected_layout(cfg.num_levels, cfg.log2_hashmap_size, cfg.base_resolution,
+                                     cfg.max_resolution);
   ASSERT_EQ(layout.num_levels(), cfg.num_levels);
   ASSERT_EQ(layout.offsets.size(), static_cast<size_t>(cfg.num_levels + 1));
   const int n_dense = static_cast<int>(e.dense_res.size());
@@ -199,8 +198,8 @@ OpResult run(bool reference, const torch::Tensor& x_in, const torch::Tensor& tab
              const torch::Tensor& upstream, const HashGridLayout& layout, bool want_grad_x) {
   torch::Tensor x = x_in.detach().clone().set_requires_grad(want_grad_x);
   torch::Tensor table = table_in.detach().clone().set_requires_grad(true);
-  torch::Tensor out = reference ? hash_grid_encode_reference(x, table, layout)
-                                : hash_grid_encode(x, table, layout);
+  torch::Tensor out =
+      reference ? hash_grid_encode_reference(x, table, layout) : hash_grid_encode(x, table, layout);
   (out * upstream).sum().backward();
   return {out.detach(), table.grad(), want_grad_x ? x.grad() : torch::Tensor()};
 }
@@ -298,10 +297,9 @@ void expect_paths_identical(const HashGridConfig& cfg, const torch::Tensor& x, i
     grad_x[p] = torch::empty({n, 3});
     hash_grid_forward_cpu<float>(x.data_ptr<float>(), n, table.data_ptr<float>(), layout,
                                  out[p].data_ptr<float>(), threads, paths[p]);
-    hash_grid_backward_cpu<float>(x.data_ptr<float>(), n, table.data_ptr<float>(),
-                                  upstream.data_ptr<float>(), layout,
-                                  grad_table[p].data_ptr<float>(), grad_x[p].data_ptr<float>(),
-                                  threads, paths[p]);
+    hash_grid_backward_cpu<float>(
+        x.data_ptr<float>(), n, table.data_ptr<float>(), upstream.data_ptr<float>(), layout,
+        grad_table[p].data_ptr<float>(), grad_x[p].data_ptr<float>(), threads, paths[p]);
   }
   EXPECT_TRUE(torch::equal(out[0], out[1]));
   EXPECT_TRUE(torch::equal(grad_table[0], grad_table[1]));
@@ -424,9 +422,9 @@ TEST(HashGridEncode, RejectsBadInputs) {
   EXPECT_THROW(hash_grid_encode(torch::rand({5, 3}, torch::kFloat64), table, layout), c10::Error);
   EXPECT_THROW(hash_grid_encode(torch::rand({3, 5}).t(), table, layout), c10::Error);
   EXPECT_THROW(hash_grid_encode(torch::rand({5, 3}), table.narrow(0, 0, 10), layout), c10::Error);
-  EXPECT_THROW(hash_grid_encode(torch::rand({5, 3}).to(torch::kInt32), table.to(torch::kInt32),
-                                layout),
-               c10::Error);
+  EXPECT_THROW(
+      hash_grid_encode(torch::rand({5, 3}).to(torch::kInt32), table.to(torch::kInt32), layout),
+      c10::Error);
 }
 
 }  // namespace

@@ -58,7 +58,7 @@ TEST(Losses, MseIsTheMeanSquaredError) {
 TEST(Losses, OuterMatchesTheOverlapDefinition) {
   torch::Generator gen = at::detail::createCPUGenerator(11);
   const auto t0 = random_edges(5, 7, gen), t1 = random_edges(5, 9, gen);
-  const auto y1 = torch::rand({5, 8}, gen, torch::kFloat64);
+  const auto y1 = torch::rand({5, 9}, gen, torch::kFloat64);
   EXPECT_TRUE(torch::allclose(outer_weights(t0, t1, y1), slow_outer(t0, t1, y1), 1e-12, 1e-12));
   // Identical bins: the outer weights are the weights themselves plus the touching neighbour
   // above (the right-closed convention).

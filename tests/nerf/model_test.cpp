@@ -130,8 +130,9 @@ TEST(NerfactoModel, TrainingForwardLossesAndGradients) {
   EXPECT_TRUE(has_grad(m->field_parameters()));
   EXPECT_TRUE(has_grad(m->proposal_parameters()));
   EXPECT_TRUE(has_grad(m->camera_parameters()));
-  for (const auto& p : m->parameters())
+  for (const auto& p : m->parameters()) {
     if (p.grad().defined()) EXPECT_TRUE(torch::isfinite(p.grad()).all().item<bool>());
+  }
 }
 
 TEST(NerfactoModel, ProposalNetworksFrozenWhenNotUpdating) {

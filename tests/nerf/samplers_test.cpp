@@ -49,7 +49,7 @@ TEST(Samplers, JitteredSamplesAreSortedInsideNearFarAndOneOffsetPerRay) {
   // Single jitter: interior edges all sit at the same fraction t_rand between the two bin
   // centres around them, i.e. edge_k = (k − ½ + t_rand)/16 for k = 1..15.
   const auto interior = r.sdist.slice(1, 1, 16) * 16.0 - torch::arange(1, 16).to(torch::kFloat32);
-  const auto spread = interior.max(1).values - interior.min(1).values;
+  const auto spread = interior.amax(1) - interior.amin(1);
   EXPECT_LT(spread.max().item<float>(), 1e-4f);
   EXPECT_GE(interior.min().item<float>(), -0.5f - 1e-5f);
   EXPECT_LE(interior.max().item<float>(), 0.5f + 1e-5f);

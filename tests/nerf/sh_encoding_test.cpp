@@ -34,7 +34,7 @@ std::array<double, 16> doc_formulas(double x, double y, double z) {
 
 TEST(ShEncoding, MatchesDocumentedFormulas) {
   const double s = 1.0 / std::sqrt(3.0);
-  const double dirs[][3] = {{1, 0, 0}, {0, 1, 0},  {0, 0, 1}, {-1, 0, 0},
+  const double dirs[][3] = {{1, 0, 0}, {0, 1, 0},  {0, 0, 1},         {-1, 0, 0},
                             {s, s, s}, {s, -s, s}, {0.48, -0.6, 0.64}};
   for (const auto& d : dirs) {
     const torch::Tensor in = torch::tensor({d[0], d[1], d[2]}, torch::kFloat64).reshape({1, 3});
@@ -42,9 +42,8 @@ TEST(ShEncoding, MatchesDocumentedFormulas) {
     ASSERT_EQ(out.sizes(), (torch::IntArrayRef{1, 16}));
     const auto expected = doc_formulas(d[0], d[1], d[2]);
     for (int k = 0; k < 16; ++k) {
-      EXPECT_NEAR(out[0][k].item<double>(), expected[k], 2e-8) << "Y" << k << " at (" << d[0]
-                                                               << ", " << d[1] << ", " << d[2]
-                                                               << ")";
+      EXPECT_NEAR(out[0][k].item<double>(), expected[k], 2e-8)
+          << "Y" << k << " at (" << d[0] << ", " << d[1] << ", " << d[2] << ")";
     }
     const torch::Tensor out_f = sh_encode(in.to(torch::kFloat32));
     for (int k = 0; k < 16; ++k) EXPECT_NEAR(out_f[0][k].item<double>(), expected[k], 1e-6);
@@ -68,8 +67,8 @@ TEST(ShEncoding, TcnnSignsAtAxes) {
 TEST(ShEncoding, ConstantsMatchClosedForms) {
   // Y0 = 1/(2√π) and the l = 1, 2, 3 normalisations, evaluated through the op.
   const double pi = std::acos(-1.0);
-  const torch::Tensor e = sh_encode(
-      torch::tensor({1.0, 0.0, 0.0, 0.0, 0.0, 1.0}, torch::kFloat64).reshape({2, 3}));
+  const torch::Tensor e =
+      sh_encode(torch::tensor({1.0, 0.0, 0.0, 0.0, 0.0, 1.0}, torch::kFloat64).reshape({2, 3}));
   EXPECT_NEAR(e[0][0].item<double>(), 1 / (2 * std::sqrt(pi)), 1e-15);
   EXPECT_NEAR(e[0][3].item<double>(), -std::sqrt(3.0) / (2 * std::sqrt(pi)), 1e-15);
   EXPECT_NEAR(e[0][8].item<double>(), std::sqrt(15.0) / (4 * std::sqrt(pi)), 1e-15);

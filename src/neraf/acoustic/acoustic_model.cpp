@@ -123,7 +123,7 @@ torch::Tensor AcousticModelImpl::render_stft_with_feature(const torch::Tensor& f
   const auto src = pose_row(src_norm, "source").expand({n, 3});
   const auto r = pose_row(rot, "rot").expand({n, 3});
   const auto out = forward_with_feature(feature, t, mic, src, r);  // [T, C, F]
-  return out.permute({1, 2, 0}).contiguous();                       // [C, F, T]
+  return out.permute({1, 2, 0}).contiguous();                      // [C, F, T]
 }
 
 torch::Tensor AcousticModelImpl::render_stft(const torch::Tensor& grid,

@@ -1,7 +1,7 @@
 #pragma once
 // The acoustic branch without its data: ResNet3D scene encoder + encoders + NAcF
-// (neraf-reference.md §1.1, §1.6). The voxel grid itself lives in GridSampler (owned by the trainer,
-// which also owns the radiance field that fills it); this module only reads it.
+// (neraf-reference.md §1.1, §1.6). The voxel grid itself lives in GridSampler (owned by the
+// trainer, which also owns the radiance field that fills it); this module only reads it.
 //
 // Grid modes (the paper's ablations):
 //   kSampled  the 7×S³ grid → ResNet3D → scene feature (the reference, default)
@@ -12,12 +12,12 @@
 // Presets (acoustic_preset): "paper" = grid 128³, ResNet3D-50/layer3 (1024 features), NAcF
 // 1187→5096→2048→1024→1024→512; "cpu" = grid 32³, small BasicBlock ResNet3D (256 features),
 // NAcF 5×512 (the paper's text), bf16 trunk matrix products.
-#include <cstdint>
-#include <string>
-
 #include <torch/nn/module.h>
 #include <torch/nn/pimpl.h>
 #include <torch/types.h>
+
+#include <cstdint>
+#include <string>
 
 #include "neraf/acoustic/grid_sampler.h"
 #include "neraf/acoustic/nacf.h"

@@ -1,10 +1,10 @@
 #include "neraf/acoustic/grid_sampler.h"
 
+#include <torch/torch.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
-
-#include <torch/torch.h>
 
 #include "neraf/util/error.h"
 
@@ -89,7 +89,8 @@ torch::Tensor grid_cell_centres(int64_t resolution, int64_t first, int64_t count
 }
 
 GridSamplerImpl::GridSamplerImpl(GridSamplerOptions options) : options_(options) {
-  require(options_.resolution >= 2, "grid resolution: must be at least 2 (cpu preset 32, paper 128)");
+  require(options_.resolution >= 2,
+          "grid resolution: must be at least 2 (cpu preset 32, paper 128)");
   require(options_.cells_per_update >= 1, "grid cells_per_update: must be positive (paper 4096)");
   require(options_.delta > 0, "grid delta: must be positive (reference 0.01)");
   if (options_.view_directions == ViewDirections::kReference) {
@@ -118,7 +119,8 @@ void GridSamplerImpl::reset() {
 
 int64_t GridSamplerImpl::pointer() const { return pointer_.item<int64_t>(); }
 
-torch::Tensor GridSamplerImpl::query_cells(const FieldQueryFn& field, const torch::Tensor& u) const {
+torch::Tensor GridSamplerImpl::query_cells(const FieldQueryFn& field,
+                                           const torch::Tensor& u) const {
   const int64_t n = u.size(0);
   const auto dirs = directions_.to(u.device());
   const int64_t d = dirs.size(0);

@@ -17,22 +17,22 @@
 //   (6 zero vectors, 6 distinct non-unit vectors each twice) for parity runs only.
 // * State: the grid and the round-robin pointer are registered buffers ("grid", "pointer"), so
 //   they travel with the module's checkpoints (the reference saves `audio_model.grid`).
+#include <torch/nn/module.h>
+#include <torch/nn/pimpl.h>
+#include <torch/types.h>
+
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <utility>
-
-#include <torch/nn/module.h>
-#include <torch/nn/pimpl.h>
-#include <torch/types.h>
 
 namespace neraf::acoustic {
 
 // The radiance field seen by the grid sampler. u: [N, 3] hash-grid input in [0,1]³, dirs: [N, 3]
 // view directions → (density [N], rgb [N, 3]). The caller binds everything else (appearance
 // embedding: the reference uses train image 0's; spatial distortion: none — u is the hash input).
-using FieldQueryFn = std::function<std::pair<torch::Tensor, torch::Tensor>(const torch::Tensor& u,
-                                                                          const torch::Tensor& dirs)>;
+using FieldQueryFn = std::function<std::pair<torch::Tensor, torch::Tensor>(
+    const torch::Tensor& u, const torch::Tensor& dirs)>;
 
 enum class ViewDirections {
   kSpread,     // `num_directions` unit vectors on a Fibonacci sphere (default; our improvement)
@@ -45,8 +45,8 @@ struct GridSamplerOptions {
   int64_t resolution = 32;          // S; preset cpu 32, paper 128
   int64_t cells_per_update = 4096;  // cells written per update (paper: 4096 = rays per batch)
   ViewDirections view_directions = ViewDirections::kSpread;
-  int64_t num_directions = 18;      // kSpread only (kReference is always 18)
-  double delta = 0.01;              // alpha = 1 − exp(−delta·density)
+  int64_t num_directions = 18;  // kSpread only (kReference is always 18)
+  double delta = 0.01;          // alpha = 1 − exp(−delta·density)
 };
 
 // Fibonacci sphere: d_i = (r cos φ_i, r sin φ_i, z_i) with z_i = 1 − (2i + 1)/n, r = √(1 − z_i²),
@@ -78,7 +78,7 @@ class GridSamplerImpl : public torch::nn::Module {
 
   // The current grid [7, S, S, S] (cells of the latest update carry autograd history).
   const torch::Tensor& grid() const { return grid_; }
-  int64_t pointer() const;  // next flat cell to write
+  int64_t pointer() const;                                         // next flat cell to write
   const torch::Tensor& directions() const { return directions_; }  // [D, 3]
   const GridSamplerOptions& options() const { return options_; }
 

@@ -27,7 +27,7 @@ torch::Tensor energy_decay_loss(const torch::Tensor& pred, const torch::Tensor& 
               gt.sizes());
   auto decay_db = [eps](const torch::Tensor& log_mag) {
     const auto m = torch::clamp_min(torch::exp(log_mag.to(torch::kFloat32)) - 1e-3, 0.0);
-    const auto e = (m * m).sum(2);                               // [B, C, T]
+    const auto e = (m * m).sum(2);                                           // [B, C, T]
     const auto d = torch::flip(torch::cumsum(torch::flip(e, {2}), 2), {2});  // Σ_{τ≥t}
     return torch::log10(d + eps);
   };

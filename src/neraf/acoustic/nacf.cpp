@@ -68,7 +68,7 @@ torch::Tensor nacf_input(const torch::Tensor& grid_feature, const torch::Tensor&
   TORCH_CHECK(mic_norm.size(0) == b && src_norm.size(0) == b && rot.size(0) == b,
               "nacf_input: batch sizes differ (t ", b, ", mic ", mic_norm.size(0), ", src ",
               src_norm.size(0), ", rot ", rot.size(0), ")");
-  const auto time = encode_time(t, max_len);  // [B, 21]
+  const auto time = encode_time(t, max_len);   // [B, 21]
   const auto mic = encode_position(mic_norm);  // [B, 63]
   const auto src = encode_position(src_norm);  // [B, 63]
   const auto r = encode_rot(rot);              // [B, 16]
@@ -116,7 +116,7 @@ torch::Tensor NacfImpl::forward(const torch::Tensor& h_in) {
   std::vector<torch::Tensor> outs;
   outs.reserve(options_.n_channels);
   for (const auto& m : *STFT_linear) outs.push_back(m->as<nn::Linear>()->forward(h));  // [B, F]
-  return torch::tanh(torch::stack(outs, 1)) * options_.output_scale;                // [B, C, F]
+  return torch::tanh(torch::stack(outs, 1)) * options_.output_scale;                   // [B, C, F]
 }
 
 int64_t NacfImpl::trunk_parameter_count() const {

@@ -1,10 +1,11 @@
 #pragma once
-// NAcF: the acoustic field MLP (neraf-reference.md §1.2-1.3). One query = (scene feature, time frame,
-// mic position, source position, orientation) → log(|STFT| + 1e-3) of one time frame, per channel.
+// NAcF: the acoustic field MLP (neraf-reference.md §1.2-1.3). One query = (scene feature, time
+// frame, mic position, source position, orientation) → log(|STFT| + 1e-3) of one time frame, per
+// channel.
 //
-// Input layout (nacf_input): [grid_feature (G), time (21), mic (63), source (63), rot (16)], G = 1024
-// for preset paper → 1187 inputs. Without a grid (use_grid = false, an ablation) the reference order
-// is [mic, source, time, rot] → 163 inputs.
+// Input layout (nacf_input): [grid_feature (G), time (21), mic (63), source (63), rot (16)], G =
+// 1024 for preset paper → 1187 inputs. Without a grid (use_grid = false, an ablation) the reference
+// order is [mic, source, time, rot] → 163 inputs.
 //   time:      t/(max_len − 1) → NeRFEncoding(1 dim, 10 freqs, 0..8, include_input) → 21
 //   positions: normalised by the audio aabb into (0,1)³, zero vector when outside (done by the data
 //              stage) → one shared NeRFEncoding(3 dims) → 63 each
@@ -20,14 +21,14 @@
 // Precision: with `bf16` the trunk's matrix products run in bfloat16 (inputs and weights cast per
 // call, fp32 master weights, fp32 gradients), activations between trunk layers stay bf16; the heads
 // stay fp32 (0.6 % of the FLOPs) so the output is not rounded to bf16's 8-bit mantissa.
-#include <cstdint>
-#include <vector>
-
 #include <torch/nn/module.h>
 #include <torch/nn/modules/container/modulelist.h>
 #include <torch/nn/modules/linear.h>
 #include <torch/nn/pimpl.h>
 #include <torch/types.h>
+
+#include <cstdint>
+#include <vector>
 
 namespace neraf::acoustic {
 
@@ -41,11 +42,11 @@ constexpr int64_t kPoseEncodingDim =
 struct NacfOptions {
   int64_t grid_features = 1024;  // G; 0 = no grid (ablation: reference order mic, src, time, rot)
   std::vector<int64_t> trunk = {5096, 2048, 1024, 1024, 512};
-  int64_t n_channels = 2;        // C: 2 SoundSpaces binaural, 1 RAF mono
-  int64_t n_freq = 257;          // F: 257 SoundSpaces (n_fft 512), 513 RAF (n_fft 1024)
+  int64_t n_channels = 2;  // C: 2 SoundSpaces binaural, 1 RAF mono
+  int64_t n_freq = 257;    // F: 257 SoundSpaces (n_fft 512), 513 RAF (n_fft 1024)
   double leaky_slope = 0.1;
-  double output_scale = 10.0;    // out = output_scale·tanh(h)
-  bool bf16 = false;             // bf16 trunk matrix products (fp32 master weights)
+  double output_scale = 10.0;  // out = output_scale·tanh(h)
+  bool bf16 = false;           // bf16 trunk matrix products (fp32 master weights)
 
   int64_t in_features() const { return grid_features + kPoseEncodingDim; }
 };
@@ -55,13 +56,14 @@ NacfOptions nacf_cpu_options(int64_t n_channels, int64_t n_freq, int64_t grid_fe
 
 // The three encodings, each [B, dim] float32.
 torch::Tensor encode_time(const torch::Tensor& t, int64_t max_len);  // t: [B] int → [B, 21]
-torch::Tensor encode_position(const torch::Tensor& p_norm);         // [B, 3] → [B, 63]
-torch::Tensor encode_rot(const torch::Tensor& rot);                 // [B, 3] → [B, 16]
+torch::Tensor encode_position(const torch::Tensor& p_norm);          // [B, 3] → [B, 63]
+torch::Tensor encode_rot(const torch::Tensor& rot);                  // [B, 3] → [B, 16]
 
 // Builds the NAcF input [B, in_features] float32.
 //   grid_feature: [G] or [1, G] (broadcast to the batch) or [B, G]; undefined → no-grid layout.
 //   t: [B] int64 frame index in [0, max_len); mic_norm, src_norm: [B, 3] normalised positions;
-//   rot: [B, 3] stored orientation ((cosθ+1)/2, 0.5, (sinθ+1)/2). Any float dtype (float64 advised).
+//   rot: [B, 3] stored orientation ((cosθ+1)/2, 0.5, (sinθ+1)/2). Any float dtype (float64
+//   advised).
 torch::Tensor nacf_input(const torch::Tensor& grid_feature, const torch::Tensor& t, int64_t max_len,
                          const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
                          const torch::Tensor& rot);

@@ -1,8 +1,8 @@
 #include "neraf/acoustic/resnet3d.h"
 
-#include <string>
-
 #include <torch/torch.h>
+
+#include <string>
 
 #include "neraf/util/error.h"
 
@@ -32,8 +32,7 @@ int64_t resnet3d_out_features(const ResNet3dOptions& options) {
 namespace {
 
 nn::Conv3d conv(int64_t in, int64_t out, int64_t kernel, int64_t stride, int64_t padding) {
-  return nn::Conv3d(
-      nn::Conv3dOptions(in, out, kernel).stride(stride).padding(padding).bias(false));
+  return nn::Conv3d(nn::Conv3dOptions(in, out, kernel).stride(stride).padding(padding).bias(false));
 }
 
 }  // namespace
@@ -55,9 +54,9 @@ ResBlock3dImpl::ResBlock3dImpl(ResBlock kind, int64_t in_channels, int64_t plane
     bn2 = register_module("bn2", nn::BatchNorm3d(planes));
   }
   if (stride != 1 || in_channels != out_channels) {
-    downsample = register_module(
-        "downsample",
-        nn::Sequential(conv(in_channels, out_channels, 1, stride, 0), nn::BatchNorm3d(out_channels)));
+    downsample =
+        register_module("downsample", nn::Sequential(conv(in_channels, out_channels, 1, stride, 0),
+                                                     nn::BatchNorm3d(out_channels)));
   }
 }
 
@@ -80,8 +79,8 @@ ResNet3dImpl::ResNet3dImpl(ResNet3dOptions options) : options_(std::move(options
   require(!o.layers.empty() && o.layers.size() == o.planes.size() &&
               o.layers.size() == o.strides.size(),
           "resnet3d: layers, planes and strides must be non-empty and of equal length");
-  conv1 = register_module("conv1", conv(o.in_channels, o.stem_channels, o.stem_kernel, 2,
-                                        o.stem_kernel / 2));
+  conv1 = register_module(
+      "conv1", conv(o.in_channels, o.stem_channels, o.stem_kernel, 2, o.stem_kernel / 2));
   bn1 = register_module("bn1", nn::BatchNorm3d(o.stem_channels));
   int64_t in = o.stem_channels;
   for (size_t s = 0; s < o.layers.size(); ++s) {

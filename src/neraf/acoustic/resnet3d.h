@@ -1,10 +1,11 @@
 #pragma once
-// Scene encoder: a 3D ResNet over the 7×S³ grid → one global feature vector (neraf-reference.md §1.5).
+// Scene encoder: a 3D ResNet over the 7×S³ grid → one global feature vector (neraf-reference.md
+// §1.5).
 //
 // Preset paper = the published ResNet3D-50 truncated after layer3: conv1 Conv3d(7→64, k5, s2, p2,
-// no bias) → BN → ReLU → MaxPool3d(k3, s2, p1); Bottleneck blocks (expansion 4) [3, 4, 6] with planes
-// [64, 128, 256] and strides [1, 2, 2] (stride on the 3×3×3 conv; 1×1×1 conv + BN downsample on the
-// first block of a stage) → 1024 channels → global average pool → 1024 features, 17,068,608
+// no bias) → BN → ReLU → MaxPool3d(k3, s2, p1); Bottleneck blocks (expansion 4) [3, 4, 6] with
+// planes [64, 128, 256] and strides [1, 2, 2] (stride on the 3×3×3 conv; 1×1×1 conv + BN downsample
+// on the first block of a stage) → 1024 channels → global average pool → 1024 features, 17,068,608
 // parameters. The reference pools with AvgPool3d(kernel 8, stride 1), which at 128³ input (8³ after
 // layer3) is exactly a global average; we use adaptive average pooling to 1³, identical there and
 // valid at every grid size. Init: Conv3d xavier_normal_, BN weight 1 / bias 0 (eps 1e-5, momentum
@@ -14,17 +15,18 @@
 // Preset cpu: the same structure with BasicBlocks (two 3×3×3 convs, expansion 1), one block per
 // stage, narrower stem — see resnet3d_cpu_options().
 //
-// Submodule names follow the reference (conv1, bn1, layer1..3 / <block>.conv1, bn1, …, downsample.0/1)
-// so a checkpoint importer maps `audio_model.resnet3d.backbone_net.*` names one to one.
-#include <cstdint>
-#include <vector>
-
+// Submodule names follow the reference (conv1, bn1, layer1..3 / <block>.conv1, bn1, …,
+// downsample.0/1) so a checkpoint importer maps `audio_model.resnet3d.backbone_net.*` names one to
+// one.
 #include <torch/nn/module.h>
 #include <torch/nn/modules/batchnorm.h>
 #include <torch/nn/modules/container/sequential.h>
 #include <torch/nn/modules/conv.h>
 #include <torch/nn/pimpl.h>
 #include <torch/types.h>
+
+#include <cstdint>
+#include <vector>
 
 namespace neraf::acoustic {
 

@@ -1,9 +1,9 @@
 #include "neraf/acoustic/schedule.h"
 
+#include <torch/torch.h>
+
 #include <algorithm>
 #include <cmath>
-
-#include <torch/torch.h>
 
 #include "neraf/util/error.h"
 
@@ -12,8 +12,8 @@ namespace neraf::acoustic {
 double scheduled_lr(const ExponentialDecaySchedule& s, int64_t step) {
   require(s.lr_init > 0 && s.lr_final > 0, "lr schedule: lr_init and lr_final must be positive");
   if (step < s.warmup_steps) {
-    const double x = std::clamp(static_cast<double>(step) / static_cast<double>(s.warmup_steps),
-                                0.0, 1.0);
+    const double x =
+        std::clamp(static_cast<double>(step) / static_cast<double>(s.warmup_steps), 0.0, 1.0);
     const double ramp = s.ramp == WarmupRamp::kSine ? std::sin(0.5 * M_PI * x) : x;
     return s.lr_pre_warmup + (s.lr_init - s.lr_pre_warmup) * ramp;
   }

@@ -10,12 +10,12 @@
 // decay, warm-up 2000 steps from 1e-8, then 1e-4 → 1e-8 over max_steps 1,002,000. `step` counts
 // scheduler steps, i.e. training steps since the optimiser was created (the reference's audio
 // optimiser steps from training step 0 because it also holds the radiance-field parameters).
+#include <torch/optim/adam.h>
+#include <torch/types.h>
+
 #include <cstdint>
 #include <memory>
 #include <vector>
-
-#include <torch/optim/adam.h>
-#include <torch/types.h>
 
 namespace neraf::acoustic {
 

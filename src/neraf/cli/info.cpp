@@ -25,7 +25,8 @@ struct InfoArgs {
 
 nlohmann::json stats_json(const data::Stats& s) {
   if (s.count == 0) return nullptr;
-  return {{"count", s.count}, {"min", s.min}, {"mean", s.mean}, {"median", s.median}, {"max", s.max}};
+  return {
+      {"count", s.count}, {"min", s.min}, {"mean", s.mean}, {"median", s.median}, {"max", s.max}};
 }
 
 nlohmann::json box_json(const data::Aabb& b) {
@@ -79,8 +80,8 @@ void run(const InfoArgs& args) {
   options.progress = !args.json;
   if (!args.no_t60) {
     options.t60 = [](const io::AudioBuffer& rir, data::AudioLayout layout) {
-      const metrics::Variant v = layout == data::AudioLayout::raf ? metrics::Variant::raf
-                                                                  : metrics::Variant::soundspaces;
+      const metrics::Variant v =
+          layout == data::AudioLayout::raf ? metrics::Variant::raf : metrics::Variant::soundspaces;
       std::vector<double> out;
       for (const auto& ch : rir.channels) {
         const metrics::DecayTime t = metrics::measure_t60(ch, rir.sample_rate, v);
@@ -124,8 +125,9 @@ void register_info(CLI::App& app) {
       "images, simulated scene), checks every file the loaders read (split entries, audio "
       "headers: sample rate, channels; poses; images vs intrinsics) and prints a summary "
       "(counts, durations, mic/source boxes, audio aabb, T60). Exits 1 if any error is found.");
-  cmd->add_option("dir", args->dir, "Dataset folder (a SoundSpaces scene, a RAF room, or a "
-                                    "nerfstudio folder with transforms.json)")
+  cmd->add_option("dir", args->dir,
+                  "Dataset folder (a SoundSpaces scene, a RAF room, or a "
+                  "nerfstudio folder with transforms.json)")
       ->required()
       ->check(CLI::ExistingDirectory);
   cmd->add_option("--max-problems", args->max_problems,

@@ -3,7 +3,9 @@
 #include <torch/torch.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 
@@ -21,7 +23,11 @@ namespace {
 
 struct TrainArgs {
   std::string data;
-  std::string modality = "vision";
+  std::string modality = "joint";
+  std::string grid = "sampled";
+  std::string vision_run;
+  double audio_fraction = 1.0;
+  int64_t audio_start = -2;
   std::string preset = "cpu";
   int64_t steps = 0;
   uint64_t seed = 42;
@@ -39,18 +45,22 @@ struct TrainArgs {
 void register_train(CLI::App& app) {
   auto args = std::make_shared<TrainArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "train", "Train a scene's radiance field from posed images (nerfstudio transforms.json)");
+      "train", "Train a scene's radiance and acoustic fields (posed images + RIRs), jointly by default");
   cmd->footer(
       "Writes RUN/config.json (the resolved config), RUN/data.json (dataset manifest) and\n"
       "RUN/checkpoints/step-XXXXXXXXX.pt. Ctrl-C saves a checkpoint and exits; continue with\n"
       "--resume. The same --seed and --threads give the same numbers.\n"
+      "Modalities: joint (default; NeRAF: radiance field + acoustic field, the grid sampled\n"
+      "from the radiance field every step), vision (radiance field only), audio (acoustic field\n"
+      "on the frozen grid of a finished run: --vision-run RUN, the paper's separate training).\n"
       "Presets: cpu (default; minutes on 2 cores for the simulator's demo room) and paper\n"
       "(exact Nerfacto/NeRAF sizes: 16-level 2^19 hash grid, proposal 256/96, 48 samples).\n"
-      "Example: neraf train --data demo/ --modality vision --out runs/demo");
+      "Example: neraf train --data demo/ --out runs/demo");
   CLI::Option* data = cmd->add_option(
       "--data", args->data, "Dataset folder (or its transforms.json); optional with --resume");
   cmd->add_option("--modality", args->modality,
-                  "What to train: vision (audio and joint come with the acoustic branch)")
+                  "What to train: joint (images + RIRs), vision (images only) or audio (RIRs on "
+                  "the frozen field of --vision-run)")
       ->check(CLI::IsMember({"vision", "audio", "joint"}))
       ->capture_default_str();
   CLI::Option* preset = cmd->add_option("--preset", args->preset, "Model and schedule preset")
@@ -73,6 +83,27 @@ void register_train(CLI::App& app) {
                       "MLP matrix products: bf16 (default where the CPU has AVX-512 bf16), fp32, "
                       "or auto")
           ->check(CLI::IsMember({"fp32", "bf16", "auto"}));
+  CLI::Option* grid =
+      cmd->add_option("--grid", args->grid,
+                      "Acoustic scene grid: sampled (from the radiance field, NeRAF), zeros (an "
+                      "all-zero grid through the same ResNet3D) or none (no grid input); the "
+                      "paper's ablations")
+          ->check(CLI::IsMember({"sampled", "none", "zeros"}))
+          ->capture_default_str();
+  CLI::Option* fraction =
+      cmd->add_option("--audio-fraction", args->audio_fraction,
+                      "Few-shot: train the acoustic field on this seeded fraction of the training "
+                      "RIRs (0 < F <= 1)")
+          ->check(CLI::Range(1e-9, 1.0))
+          ->capture_default_str();
+  CLI::Option* vision_run = cmd->add_option(
+      "--vision-run", args->vision_run,
+      "With --modality audio: the finished vision (or joint) run whose radiance field fills "
+      "the grid (frozen)");
+  CLI::Option* audio_start = cmd->add_option(
+      "--audio-start-step", args->audio_start,
+      "Audio losses start after this step (default: the preset's; cpu 1500, paper 2000; audio "
+      "modality 0)");
   cmd->add_option("--out", args->out, "Run folder to create (or to resume)")->required();
   cmd->add_flag("--resume", args->resume,
                 "Continue the run in --out from its latest checkpoint (uses its config.json)");
@@ -80,17 +111,39 @@ void register_train(CLI::App& app) {
                 "Start over in a non-empty --out folder (deletes its checkpoints)");
   cmd->add_flag("--quiet", args->quiet, "No progress bar");
 
-  cmd->callback([args, data, preset, steps, seed, threads, rays, precision]() {
+  cmd->callback([args, data, preset, steps, seed, threads, rays, precision, grid, fraction,
+                 vision_run, audio_start]() {
     require(!(args->resume && args->force), "--resume and --force: choose one");
     require(args->resume || data->count() > 0, "--data: required (the dataset folder)");
     train::TrainConfig cfg = train::train_preset(args->preset);
     cfg.modality = train::parse_modality(args->modality);
+    const bool paper = args->preset == "paper";
+    if (cfg.modality == train::Modality::joint && paper)
+      cfg.steps = 400001;  // NeRAF's max_num_iterations (audio from step 2001)
+    if (cfg.modality == train::Modality::audio) {
+      // The radiance field is final (the grid is filled once): audio from the first step.
+      cfg.audio.start_step = -1;
+      cfg.steps = paper ? 398000 : 1500;
+      cfg.audio.schedule.warmup_steps = paper ? 2000 : 100;
+      if (!paper) cfg.audio.schedule.max_steps = cfg.steps;
+    }
     if (steps->count()) {
-      for (train::ScheduleConfig* s : {&cfg.fields, &cfg.proposal_networks})
+      for (train::ScheduleConfig* s : {&cfg.fields, &cfg.proposal_networks, &cfg.audio.schedule})
         if (s->max_steps == cfg.steps) s->max_steps = args->steps;  // decay tied to run length
       cfg.steps = args->steps;
     }
     cfg.seed = args->seed;
+    if (audio_start->count()) {
+      if (cfg.audio.schedule.warmup_steps == cfg.audio.start_step)  // warm-up ends at the start
+        cfg.audio.schedule.warmup_steps = std::max<int64_t>(0, args->audio_start);
+      cfg.audio.start_step = args->audio_start;
+    }
+    cfg.audio.grid = args->grid;
+    cfg.audio.fraction = args->audio_fraction;
+    if (vision_run->count())
+      cfg.audio.vision_run = std::filesystem::absolute(args->vision_run).lexically_normal().string();
+    require(cfg.modality == train::Modality::audio || vision_run->count() == 0,
+            "--vision-run: only used with --modality audio");
     if (threads->count()) cfg.threads = args->threads;
     if (rays->count()) cfg.rays_per_batch = args->rays;
     if (precision->count()) cfg.model.precision = nerf::parse_precision(args->precision, "--precision");
@@ -105,7 +158,7 @@ void register_train(CLI::App& app) {
     opts.progress = !args->quiet;
     if (args->resume) {
       // The run's own config wins; flags that would change the model are refused.
-      for (CLI::Option* o : {preset, seed, rays, precision})
+      for (CLI::Option* o : {preset, seed, rays, precision, grid, fraction, vision_run, audio_start})
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json is "
                                      "used); start a new run with --out to change it");
@@ -116,10 +169,11 @@ void register_train(CLI::App& app) {
     opts.stop = &interrupt.flag();
     const train::TrainRunSummary s = train::run_training(cfg, opts);
     if (s.end_step > s.start_step)
-      std::printf("trained steps %lld..%lld in %.1f s (%.0f rays/s); train PSNR %.2f dB; "
-                  "checkpoint %s\n",
+      std::printf("trained steps %lld..%lld in %.1f s (%.2f steps/s, %.0f rays/s); train PSNR "
+                  "%.2f dB; audio log-mag MSE %.4f; checkpoint %s\n",
                   static_cast<long long>(s.start_step), static_cast<long long>(s.end_step),
-                  s.seconds, s.rays_per_s, s.last_psnr, s.checkpoint.c_str());
+                  s.seconds, s.seconds > 0 ? (s.end_step - s.start_step) / s.seconds : 0.0,
+                  s.rays_per_s, s.last_psnr, s.last_audio_sl, s.checkpoint.c_str());
   });
 }
 

@@ -7,11 +7,11 @@
 namespace neraf::data {
 
 struct AudioProbe {
-  bool ok = false;      // a readable audio header
-  std::string error;    // why not (when !ok): "no such file", libsndfile's reason, ...
+  bool ok = false;    // a readable audio header
+  std::string error;  // why not (when !ok): "no such file", libsndfile's reason, ...
   int sample_rate = 0;
   int channels = 0;
-  int64_t frames = 0;   // 0 for a header-only (empty) file
+  int64_t frames = 0;  // 0 for a header-only (empty) file
 
   double duration_s() const { return sample_rate > 0 ? double(frames) / sample_rate : 0.0; }
 };

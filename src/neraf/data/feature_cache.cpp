@@ -231,8 +231,9 @@ std::shared_ptr<FeatureCache> FeatureCache::build(
                                   "); free disk space or choose another --cache-dir");
   });
   auto c = open(path, spec);
-  require(c != nullptr, path + ": the feature cache just written cannot be read back; delete the "
-                               "folder and retry");
+  require(c != nullptr, path +
+                            ": the feature cache just written cannot be read back; delete the "
+                            "folder and retry");
   return c;
 }
 

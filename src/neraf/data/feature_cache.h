@@ -39,12 +39,12 @@ class FeatureCache {
   static std::shared_ptr<FeatureCache> open(const std::string& path, const FeatureCacheSpec& spec);
 
   // Computes every RIR's features with `compute(i, out)` in parallel (OpenMP), where `out` holds
-  // max_len·channels·n_freq floats [max_len][channels][n_freq] and the return value is the RIR's own
-  // STFT length; writes them to `path` atomically (temporary file + rename) and maps the result.
-  // The first exception thrown by `compute` is rethrown after the workers stop.
-  static std::shared_ptr<FeatureCache> build(
-      const std::string& path, const FeatureCacheSpec& spec,
-      const std::function<int64_t(int64_t, float*)>& compute, bool progress);
+  // max_len·channels·n_freq floats [max_len][channels][n_freq] and the return value is the RIR's
+  // own STFT length; writes them to `path` atomically (temporary file + rename) and maps the
+  // result. The first exception thrown by `compute` is rethrown after the workers stop.
+  static std::shared_ptr<FeatureCache> build(const std::string& path, const FeatureCacheSpec& spec,
+                                             const std::function<int64_t(int64_t, float*)>& compute,
+                                             bool progress);
 
   ~FeatureCache();
   FeatureCache(const FeatureCache&) = delete;

@@ -1,5 +1,6 @@
 #include "neraf/data/image_set.h"
 
+#include <omp.h>
 #include <stb/stb_image.h>
 
 #include <algorithm>
@@ -9,7 +10,6 @@
 #include <cstring>
 #include <filesystem>
 #include <nlohmann/json.hpp>
-#include <omp.h>
 
 #include "neraf/io/atomic_file.h"
 #include "neraf/io/json_file.h"
@@ -26,7 +26,7 @@ namespace {
 using Mat3 = std::array<std::array<double, 3>, 3>;
 
 struct Frame {
-  int json_index = 0;  // index in transforms.json "frames" (what users can find in the file)
+  int json_index = 0;     // index in transforms.json "frames" (what users can find in the file)
   std::string file_path;  // as written in the json
   std::string path;       // resolved on disk
   Intrinsics intr;
@@ -114,8 +114,9 @@ void read_pose(const json& frame, Frame& f, ProblemList& problems, const std::st
     for (int c = 0; c < 4; ++c) {
       // NaN / Infinity arrive here as null (read_json_lenient).
       if (!m[r][c].is_number()) {
-        problems.error(file, where + ": transform_matrix[" + std::to_string(r) + "][" +
-                                 std::to_string(c) + "] is NaN, infinite or not a number",
+        problems.error(file,
+                       where + ": transform_matrix[" + std::to_string(r) + "][" +
+                           std::to_string(c) + "] is NaN, infinite or not a number",
                        "fix or drop the frame (its pose is not valid)");
         return;
       }
@@ -220,8 +221,8 @@ struct Parsed {
 Parsed parse(const std::string& path_in, const ImageLoadOptions& options, ProblemList& problems) {
   Parsed out;
   std::error_code ec;
-  out.json_path = fs::is_directory(path_in, ec) ? (fs::path(path_in) / "transforms.json").string()
-                                                : path_in;
+  out.json_path =
+      fs::is_directory(path_in, ec) ? (fs::path(path_in) / "transforms.json").string() : path_in;
   out.data_dir = fs::path(out.json_path).parent_path().string();
   if (out.data_dir.empty()) out.data_dir = ".";
   const std::string& file = out.json_path;
@@ -301,8 +302,8 @@ Parsed parse(const std::string& path_in, const ImageLoadOptions& options, Proble
     f.intr.width = static_cast<int>(w);
     f.intr.height = static_cast<int>(h);
     // Distortion: nerfstudio treats the distortion as global if ANY coefficient is global.
-    const bool distort_global = meta.contains("k1") || meta.contains("k2") ||
-                                meta.contains("k3") || meta.contains("p1") || meta.contains("p2");
+    const bool distort_global = meta.contains("k1") || meta.contains("k2") || meta.contains("k3") ||
+                                meta.contains("p1") || meta.contains("p2");
     const json& dsrc = distort_global ? meta : fr;
     read_number(dsrc, "k1", f.intr.k1);
     read_number(dsrc, "k2", f.intr.k2);
@@ -493,7 +494,8 @@ ImageSet build(const std::string& path, const ImageLoadOptions& options, Problem
     }
   }
   std::array<double, 3> t{};
-  for (int r = 0; r < 3; ++r) t[r] = -(rot[r][0] * mean[0] + rot[r][1] * mean[1] + rot[r][2] * mean[2]);
+  for (int r = 0; r < 3; ++r)
+    t[r] = -(rot[r][0] * mean[0] + rot[r][1] * mean[1] + rot[r][2] * mean[2]);
   // Oriented poses: [rot·Rc | rot·tc + t].
   std::vector<std::array<double, 12>> oriented(p.frames.size());
   double max_abs_t = 0;
@@ -594,7 +596,8 @@ ImageSet load_transforms_json(const std::string& path, const ImageLoadOptions& o
 torch::Tensor to_normalized_world(const ImageSet& set, const torch::Tensor& points) {
   TORCH_CHECK(points.dim() == 2 && points.size(1) == 3, "points must be [N, 3]");
   const torch::Tensor p = points.to(torch::kFloat64);
-  const torch::Tensor r = set.world_transform.index({torch::indexing::Slice(), torch::indexing::Slice(0, 3)});
+  const torch::Tensor r =
+      set.world_transform.index({torch::indexing::Slice(), torch::indexing::Slice(0, 3)});
   const torch::Tensor t = set.world_transform.index({torch::indexing::Slice(), 3});
   return (p.matmul(r.t()) + t) * set.world_scale;
 }

@@ -34,8 +34,8 @@ struct ImageSet {
   // Maps dataset world coordinates to the normalised frame: p_norm = scale * (R p + t).
   torch::Tensor world_transform;  // [3, 4] float64: [R | t] before scaling
   double world_scale = 1.0;
-  std::string source;             // the transforms.json it was read from
-  std::string eval_mode;          // the split rule used: "filename" | "fraction" | "lists"
+  std::string source;     // the transforms.json it was read from
+  std::string eval_mode;  // the split rule used: "filename" | "fraction" | "lists"
 };
 
 struct ImageLoadOptions {

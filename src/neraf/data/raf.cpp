@@ -1,8 +1,9 @@
-// RAF (Real Acoustic Fields) in the layout the published NeRAF code reads (neraf-reference.md §3.3):
-//   <room>/metadata/data-split.json   {"train": [[ids]], "validation": [[...], ...], "test": [[ids]]}
-//   <room>/data/<id>/rir.wav          mono, 48 kHz
-//   <room>/data/<id>/rx_pos.txt       "x,y,z"                 microphone (omni), m
-//   <room>/data/<id>/tx_pos.txt       "qx,qy,qz,qw,x,y,z"     source orientation (real last) + position
+// RAF (Real Acoustic Fields) in the layout the published NeRAF code reads (neraf-reference.md
+// §3.3):
+//   <room>/metadata/data-split.json   {"train": [[ids]], "validation": [[...], ...], "test":
+//   [[ids]]} <room>/data/<id>/rir.wav          mono, 48 kHz <room>/data/<id>/rx_pos.txt "x,y,z"
+//   microphone (omni), m <room>/data/<id>/tx_pos.txt       "qx,qy,qz,qw,x,y,z"     source
+//   orientation (real last) + position
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -121,7 +122,8 @@ RirIndex index_raf(const std::string& dir, ProblemList& problems) {
         std::snprintf(buf, sizeof buf, "%06lld", static_cast<long long>(list[k].get<int64_t>()));
         id = buf;
       } else {
-        problems.error(split_path, where + " is not an id", "ids are numbers or \"000123\" strings");
+        problems.error(split_path, where + " is not an id",
+                       "ids are numbers or \"000123\" strings");
         continue;
       }
       std::string folder = (fs::path(dir) / "data" / id).string();
@@ -162,7 +164,8 @@ RirIndex index_raf(const std::string& dir, ProblemList& problems) {
       const std::string rx_path = (fs::path(folder) / "rx_pos.txt").string();
       const std::string tx_path = (fs::path(folder) / "tx_pos.txt").string();
       if (!read_numbers(rx_path, rx, text) || rx.size() != 3) {
-        problems.error(rx_path, "missing or not \"x,y,z\"", "restore the file from the RAF release");
+        problems.error(rx_path, "missing or not \"x,y,z\"",
+                       "restore the file from the RAF release");
         continue;
       }
       if (!read_numbers(tx_path, tx, text) || tx.size() != 7) {

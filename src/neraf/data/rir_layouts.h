@@ -19,7 +19,7 @@ struct FileStamp {
 FileStamp stamp(const std::string& path);
 
 struct RirIndex {
-  RirSet set;  // poses, splits, paths; no features
+  RirSet set;                  // poses, splits, paths; no features
   std::vector<FileStamp> wav;  // per RIR
   std::vector<FileStamp> npy;  // per RIR (SoundSpaces magnitude files; empty for RAF)
   bool use_npy = false;        // every RIR has a magnitude file and they are wanted

@@ -43,8 +43,10 @@ geometry::Vec3 normalize_position(const geometry::Vec3& p, const Aabb& box) {
 torch::Tensor normalize_position(const torch::Tensor& p, const Aabb& box) {
   TORCH_CHECK(p.dim() == 2 && p.size(1) == 3, "normalize_position: positions must be [N, 3]");
   const auto opts = torch::TensorOptions().dtype(p.scalar_type());
-  const torch::Tensor lo = torch::tensor({box.min.x, box.min.y, box.min.z}, torch::kFloat64).to(opts);
-  const torch::Tensor hi = torch::tensor({box.max.x, box.max.y, box.max.z}, torch::kFloat64).to(opts);
+  const torch::Tensor lo =
+      torch::tensor({box.min.x, box.min.y, box.min.z}, torch::kFloat64).to(opts);
+  const torch::Tensor hi =
+      torch::tensor({box.max.x, box.max.y, box.max.z}, torch::kFloat64).to(opts);
   torch::Tensor q = (p - lo) / (hi - lo);
   const torch::Tensor inside = ((q > 0) & (q < 1)).all(1, /*keepdim=*/true);
   return q * inside.to(q.scalar_type());
@@ -187,8 +189,8 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
     const Rir& r = set.rirs[i];
     const std::string& path = npy ? r.magnitude_path : r.wav_path;
     const detail::FileStamp& st = npy ? idx.npy[i] : idx.wav[i];
-    files << r.id << '\t' << fs::path(path).lexically_relative(set.root).string() << '\t'
-          << st.size << '\t' << st.mtime_ns << '\n';
+    files << r.id << '\t' << fs::path(path).lexically_relative(set.root).string() << '\t' << st.size
+          << '\t' << st.mtime_ns << '\n';
   }
   FeatureCacheSpec spec;
   spec.key = hash_hex(params.str() + files.str());
@@ -207,15 +209,17 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
     if (!writable_dir(dir)) {
       const char* xdg = std::getenv("XDG_CACHE_HOME");
       const char* home = std::getenv("HOME");
-      const std::string fallback =
-          xdg && *xdg ? std::string(xdg) + "/neraf" : std::string(home ? home : "/tmp") + "/.cache/neraf";
+      const std::string fallback = xdg && *xdg
+                                       ? std::string(xdg) + "/neraf"
+                                       : std::string(home ? home : "/tmp") + "/.cache/neraf";
       warn(set.root + ": the dataset folder is not writable; caching audio features in " +
            fallback + " (pass --cache-dir to choose)");
       dir = fallback;
     }
   }
-  require(writable_dir(dir), dir + ": cannot create or write the feature cache folder; pass a "
-                                   "writable --cache-dir");
+  require(writable_dir(dir), dir +
+                                 ": cannot create or write the feature cache folder; pass a "
+                                 "writable --cache-dir");
   const std::string prefix =
       sanitize(fs::path(set.root).lexically_normal().filename().string().empty()
                    ? fs::absolute(set.root).parent_path().filename().string()
@@ -231,8 +235,9 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
       detail::parallel_for_each(n, [&](int64_t i) {
         if (npy) {
           const io::NpyHeader h = io::read_npy_header(set.rirs[i].magnitude_path);
-          require(h.shape.size() == 3, set.rirs[i].magnitude_path +
-                                           ": expected magnitudes of shape [2, 257, T]; re-create it");
+          require(h.shape.size() == 3,
+                  set.rirs[i].magnitude_path +
+                      ": expected magnitudes of shape [2, 257, T]; re-create it");
           frames[i] = h.shape[2];
         } else {
           const AudioProbe p = probe_audio(set.rirs[i].wav_path);
@@ -245,7 +250,8 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
     const int64_t max_len = spec.max_len;
     const double gb = double(n) * max_len * set.channels * set.n_freq * (spec.half ? 2 : 4) / 1e9;
     char msg[160];
-    std::snprintf(msg, sizeof msg, "%s: building the audio feature cache (%lld RIRs x %lld frames, %.2f GB)",
+    std::snprintf(msg, sizeof msg,
+                  "%s: building the audio feature cache (%lld RIRs x %lld frames, %.2f GB)",
                   set.root.c_str(), static_cast<long long>(n), static_cast<long long>(max_len), gb);
     if (options.progress) info(msg);
     std::function<int64_t(int64_t, float*)> compute;
@@ -267,7 +273,8 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
     std::error_code ec;
     for (const auto& e : fs::directory_iterator(dir, ec)) {
       const std::string name = e.path().filename().string();
-      if (e.path().string() != path && name.rfind(prefix, 0) == 0 && e.path().extension() == ".bin") {
+      if (e.path().string() != path && name.rfind(prefix, 0) == 0 &&
+          e.path().extension() == ".bin") {
         fs::remove(e.path(), ec);
         if (!ec && options.progress) info("removed the stale feature cache " + e.path().string());
       }
@@ -315,15 +322,17 @@ RirSet load_rir_set(const std::string& dir, const RirLoadOptions& options) {
   const DatasetLayout d = detect_layout(dir);
   if (d.soundspaces) return load_soundspaces(dir, options);
   if (d.raf) return load_raf(dir, options);
-  throw Error(dir + ": no impulse responses found (neither SoundSpaces binaural_rirs/ + "
-                    "metadata/points.txt nor RAF data/ + metadata/data-split.json); check the path");
+  throw Error(dir +
+              ": no impulse responses found (neither SoundSpaces binaural_rirs/ + "
+              "metadata/points.txt nor RAF data/ + metadata/data-split.json); check the path");
 }
 
 // ---------------------------------------------------------------------------------------------
 
 torch::Tensor RirSet::features(int64_t i) const {
   require(cache_ != nullptr, "RirSet: features were not loaded (RirLoadOptions::load_features)");
-  TORCH_CHECK(i >= 0 && i < size(), "RirSet::features: index ", i, " out of range [0, ", size(), ")");
+  TORCH_CHECK(i >= 0 && i < size(), "RirSet::features: index ", i, " out of range [0, ", size(),
+              ")");
   torch::Tensor tcf = torch::empty({max_len, channels, n_freq}, torch::kFloat32);
   cache_->read_frames(i, 0, max_len, tcf.data_ptr<float>());
   return tcf.permute({1, 2, 0}).contiguous();  // [C, F, T]
@@ -362,12 +371,14 @@ torch::Tensor RirSet::gather(const torch::Tensor& rir, const torch::Tensor& fram
 
 torch::Tensor RirSet::waveform(int64_t i) const {
   TORCH_CHECK(i >= 0 && i < size(), "RirSet::waveform: index ", i, " out of range");
-  require(waveform_length > 0, "RirSet: max_len is unknown until features are loaded (or "
-                               "RirLoadOptions::max_len is given)");
+  require(waveform_length > 0,
+          "RirSet: max_len is unknown until features are loaded (or "
+          "RirLoadOptions::max_len is given)");
   const auto chans = layout == AudioLayout::soundspaces
                          ? detail::soundspaces_waveform(rirs[i].wav_path, waveform_length)
                          : detail::raf_waveform(rirs[i].wav_path, waveform_length);
-  torch::Tensor w = torch::empty({static_cast<int64_t>(chans.size()), waveform_length}, torch::kFloat32);
+  torch::Tensor w =
+      torch::empty({static_cast<int64_t>(chans.size()), waveform_length}, torch::kFloat32);
   for (size_t c = 0; c < chans.size(); ++c)
     std::copy(chans[c].begin(), chans[c].end(), w[c].data_ptr<float>());
   return w;

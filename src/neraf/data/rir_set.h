@@ -53,12 +53,12 @@ std::array<double, 3> encode_heading(int heading_deg);
 struct Rir {
   std::string id;        // SoundSpaces "<rot>/<r>_<s>" (the split.json entry); RAF the folder id
   std::string wav_path;  // the impulse response
-  std::string magnitude_path;  // SoundSpaces binaural_magnitudes_sr22050/<rot>/<r>_<s>.npy if
-                               // present (its magnitudes are used instead of the wav's)
-  geometry::Vec3 mic;     // m, dataset frame as NeRAF uses it
-  geometry::Vec3 source;  // m
-  int heading_deg = 0;    // θ that `rot` encodes (integer degrees)
-  double raw_yaw_deg = 0;      // before rounding (RAF quaternion yaw; SoundSpaces = heading_deg)
+  std::string magnitude_path;   // SoundSpaces binaural_magnitudes_sr22050/<rot>/<r>_<s>.npy if
+                                // present (its magnitudes are used instead of the wav's)
+  geometry::Vec3 mic;           // m, dataset frame as NeRAF uses it
+  geometry::Vec3 source;        // m
+  int heading_deg = 0;          // θ that `rot` encodes (integer degrees)
+  double raw_yaw_deg = 0;       // before rounding (RAF quaternion yaw; SoundSpaces = heading_deg)
   std::array<double, 3> rot{};  // encode_heading(heading_deg)
   int64_t num_frames = 0;  // the RIR's own STFT length before padding/cutting (0 until features
                            // are loaded)
@@ -69,23 +69,23 @@ struct RirLoadOptions {
   // the split (train and test), which we believe is how the published per-scene values (office_4
   // 78 ... frl_apartment_2 107) were chosen.
   int64_t max_len = 0;
-  bool load_features = true;  // false: poses and splits only (fast; features()/gather() throw)
-  std::string cache_dir;      // "" = <scene>/.neraf_cache (falls back to ~/.cache/neraf/<hash>
-                              // when the scene folder is not writable)
-  bool half_precision = false;      // float16 cache: half the disk, ~1e-3 relative rounding
+  bool load_features = true;    // false: poses and splits only (fast; features()/gather() throw)
+  std::string cache_dir;        // "" = <scene>/.neraf_cache (falls back to ~/.cache/neraf/<hash>
+                                // when the scene folder is not writable)
+  bool half_precision = false;  // float16 cache: half the disk, ~1e-3 relative rounding
   bool use_magnitude_files = true;  // SoundSpaces: prefer the published .npy magnitudes
   bool progress = true;
 };
 
 struct RirSet {
   AudioLayout layout = AudioLayout::soundspaces;
-  std::string root;        // the dataset folder
-  int wav_sample_rate = 0;     // rate of the files: 44100 (SoundSpaces) / 48000 (RAF)
-  int sample_rate = 0;         // rate of features and eval waveforms: 22050 / 48000
-  int channels = 0;            // 2 (binaural) / 1
-  dsp::StftParams stft;        // soundspaces() / raf()
-  int64_t n_freq = 0;          // 257 / 513
-  int64_t max_len = 0;         // frames per RIR
+  std::string root;             // the dataset folder
+  int wav_sample_rate = 0;      // rate of the files: 44100 (SoundSpaces) / 48000 (RAF)
+  int sample_rate = 0;          // rate of features and eval waveforms: 22050 / 48000
+  int channels = 0;             // 2 (binaural) / 1
+  dsp::StftParams stft;         // soundspaces() / raf()
+  int64_t n_freq = 0;           // 257 / 513
+  int64_t max_len = 0;          // frames per RIR
   int64_t waveform_length = 0;  // eval ground truth: max_len·128 (SoundSpaces) / 15360 (RAF)
 
   std::vector<Rir> rirs;             // train RIRs first (split order), then test

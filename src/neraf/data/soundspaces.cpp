@@ -1,7 +1,7 @@
 // SoundSpaces 1.0 (Replica) in the layout the published NeRAF code reads (neraf-reference.md §3.2):
 //   <scene>/metadata/points.txt                          idx \t x \t y \t z  (Habitat, y up)
-//   <scene>/metadata_AudioNeRF/split.json                {"train": ["<rot>/<r>_<s>", ...], "test": [...]}
-//   <scene>/binaural_rirs/<rot>/<r>_<s>.wav              44.1 kHz, 2 channels
+//   <scene>/metadata_AudioNeRF/split.json                {"train": ["<rot>/<r>_<s>", ...], "test":
+//   [...]} <scene>/binaural_rirs/<rot>/<r>_<s>.wav              44.1 kHz, 2 channels
 //   <scene>/binaural_magnitudes_sr22050/<rot>/<r>_<s>.npy  optional [2, 257, T] magnitudes
 #include <algorithm>
 #include <cmath>
@@ -72,7 +72,8 @@ std::vector<std::vector<float>> read_binaural(const std::string& wav) {
 
 }  // namespace
 
-RirIndex index_soundspaces(const std::string& dir, bool use_magnitude_files, ProblemList& problems) {
+RirIndex index_soundspaces(const std::string& dir, bool use_magnitude_files,
+                           ProblemList& problems) {
   RirIndex idx;
   RirSet& set = idx.set;
   set.layout = AudioLayout::soundspaces;
@@ -117,14 +118,16 @@ RirIndex index_soundspaces(const std::string& dir, bool use_magnitude_files, Pro
       }
       const std::string where = "line " + std::to_string(line_no);
       if (!ok) {
-        problems.error(points_path, where + ": expected 'idx<TAB>x<TAB>y<TAB>z', got '" + line + "'",
+        problems.error(points_path,
+                       where + ": expected 'idx<TAB>x<TAB>y<TAB>z', got '" + line + "'",
                        "fix the line");
         continue;
       }
       if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
-        problems.error(points_path, where + ": point " + std::to_string(id) +
-                                        " has a NaN or infinite coordinate",
-                       "fix the coordinates or remove the point and the RIRs that use it");
+        problems.error(
+            points_path,
+            where + ": point " + std::to_string(id) + " has a NaN or infinite coordinate",
+            "fix the coordinates or remove the point and the RIRs that use it");
         continue;
       }
       if (points.count(id)) {
@@ -180,7 +183,8 @@ RirIndex index_soundspaces(const std::string& dir, bool use_magnitude_files, Pro
       int rot = 0;
       long r = 0, s = 0;
       if (!parse_entry(entry, rot, r, s)) {
-        problems.error(split_path, where + " \"" + entry + "\" is not \"<rot>/<receiver>_<source>\"",
+        problems.error(split_path,
+                       where + " \"" + entry + "\" is not \"<rot>/<receiver>_<source>\"",
                        "entries look like \"270/122_44\"");
         continue;
       }
@@ -200,7 +204,8 @@ RirIndex index_soundspaces(const std::string& dir, bool use_magnitude_files, Pro
       }
       Rir rir;
       rir.id = entry;
-      const std::string stem = std::to_string(rot) + "/" + std::to_string(r) + "_" + std::to_string(s);
+      const std::string stem =
+          std::to_string(rot) + "/" + std::to_string(r) + "_" + std::to_string(s);
       rir.wav_path = join(dir, "binaural_rirs/" + stem + ".wav");
       const std::string npy = join(dir, "binaural_magnitudes_sr22050/" + stem + ".npy");
       rir.mic = pr->second;
@@ -274,13 +279,15 @@ int64_t soundspaces_features_from_npy(const std::string& npy, int64_t max_len, f
   const io::NpyArray a = io::read_npy(npy);
   const int64_t n_freq = dsp::StftParams::soundspaces().n_freq();
   require(a.shape.size() == 3 && a.shape[0] == 2 && a.shape[1] == n_freq && a.shape[2] > 0,
-          npy + ": expected magnitudes of shape [2, 257, T], got a different shape; re-create "
-                "the file or delete binaural_magnitudes_sr22050/ to compute features from the wavs");
+          npy +
+              ": expected magnitudes of shape [2, 257, T], got a different shape; re-create "
+              "the file or delete binaural_magnitudes_sr22050/ to compute features from the wavs");
   const int64_t n_frames = a.shape[2];
   for (const float v : a.data)
     require(std::isfinite(v) && v >= 0,
-            npy + ": contains negative or non-finite magnitudes; re-create the file or delete "
-                  "binaural_magnitudes_sr22050/ to compute features from the wavs");
+            npy +
+                ": contains negative or non-finite magnitudes; re-create the file or delete "
+                "binaural_magnitudes_sr22050/ to compute features from the wavs");
   write_padded_log({a.data.data(), a.data.data() + n_freq * n_frames}, n_freq, n_frames, max_len,
                    out);
   return n_frames;

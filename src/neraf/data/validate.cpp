@@ -37,7 +37,8 @@ Stats compute_stats(std::vector<double> v) {
 }
 
 int64_t DatasetReport::num_errors() const {
-  return std::count_if(problems.begin(), problems.end(), [](const Problem& p) { return p.is_error(); });
+  return std::count_if(problems.begin(), problems.end(),
+                       [](const Problem& p) { return p.is_error(); });
 }
 int64_t DatasetReport::num_warnings() const {
   return static_cast<int64_t>(problems.size()) - num_errors();

@@ -47,18 +47,18 @@ struct DatasetReport {
   // Audio (when layout.has_audio()).
   AudioLayout audio_layout = AudioLayout::soundspaces;
   int64_t rirs_train = 0, rirs_test = 0;
-  int64_t magnitude_files = 0;     // SoundSpaces .npy files found for the split's RIRs
-  int expected_sample_rate = 0;    // what the layout requires (44100 / 48000)
-  int expected_channels = 0;       // 2 / 1
-  Stats duration_s;                // over every readable RIR (from the headers)
-  Aabb mic_box, source_box;        // all RIRs
-  Aabb audio_aabb;                 // train mics ± 1 m
-  int64_t test_mics_outside = 0;     // test mics the position normalisation zeroes
-  int64_t sources_outside = 0;       // sources (all RIRs) outside the audio aabb -> zeroed
-  Stats t60_s;                     // per channel, valid values only
-  int64_t t60_rirs = 0;            // RIRs measured
-  int64_t t60_invalid = 0;         // channels without a T60 value
-  bool t60_subsampled = false;     // true when t60_rirs < number of RIRs
+  int64_t magnitude_files = 0;    // SoundSpaces .npy files found for the split's RIRs
+  int expected_sample_rate = 0;   // what the layout requires (44100 / 48000)
+  int expected_channels = 0;      // 2 / 1
+  Stats duration_s;               // over every readable RIR (from the headers)
+  Aabb mic_box, source_box;       // all RIRs
+  Aabb audio_aabb;                // train mics ± 1 m
+  int64_t test_mics_outside = 0;  // test mics the position normalisation zeroes
+  int64_t sources_outside = 0;    // sources (all RIRs) outside the audio aabb -> zeroed
+  Stats t60_s;                    // per channel, valid values only
+  int64_t t60_rirs = 0;           // RIRs measured
+  int64_t t60_invalid = 0;        // channels without a T60 value
+  bool t60_subsampled = false;    // true when t60_rirs < number of RIRs
 
   // Images (when layout.nerfstudio).
   int64_t images_train = 0, images_eval = 0;

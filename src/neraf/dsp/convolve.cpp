@@ -67,14 +67,15 @@ std::vector<float> fft_convolve(const std::vector<float>& a, const std::vector<f
   std::vector<float> y(out_len);
   // Overlap-save: block k yields outputs [k·L, k·L + L) from inputs [k·L − (m−1), k·L + L), with
   // L = n − m + 1 (the circular wrap only touches the first m − 1 samples, which are dropped).
-  // Blocks write disjoint outputs, so they run in parallel with identical results.
+  // Blocks write disjoint outputs, so they run in parallel with identical results (handed out one
+  // at a time: a thread that gets descheduled on a busy machine delays at most one block).
   const size_t L = n - m + 1;
   const int64_t n_blocks = static_cast<int64_t>((out_len + L - 1) / L);
   const int64_t nx = static_cast<int64_t>(x.size());
 #pragma omp parallel if (n_blocks > 1)
   {
     AlignedFloats buf = detail::alloc_floats(nc2);
-#pragma omp for schedule(static)
+#pragma omp for schedule(dynamic, 1)
     for (int64_t k = 0; k < n_blocks; ++k) {
       const int64_t start = k * int64_t(L) - int64_t(m - 1);
       float* s = buf.get();

@@ -115,6 +115,7 @@ std::vector<std::vector<float>> run(const std::vector<const Matrix*>& mags, cons
           "griffin_lim: STFT parameters must be centred (torchaudio's griffinlim always "
           "uses center=True)");
   require(o.n_iter >= 0, "griffin_lim: n_iter must be >= 0, got " + std::to_string(o.n_iter));
+  require(o.threads >= 0, "griffin_lim: threads must be >= 0 (0: automatic)");
   require(o.momentum >= 0.0f && o.momentum < 1.0f,
           "griffin_lim: momentum must be in [0, 1), got " + std::to_string(o.momentum));
   const StftEngine e(p);
@@ -228,17 +229,16 @@ std::vector<std::vector<float>> run(const std::vector<const Matrix*>& mags, cons
 
   // Per thread: the windowed frame fed to the r2c (zero outside the window support, which is
   // never written) and the reflected samples of frames that reach into the centre padding.
-  const int n_threads = omp_get_max_threads();
-  const bool parallel =
-      int64_t(n_ch) * T * n >= kParallelSamples && n_threads > 1 && !omp_in_parallel();
+  int n_threads = o.threads > 0 ? o.threads : omp_get_max_threads();
+  if (o.threads == 0 && (omp_in_parallel() || detail::cores_busy())) n_threads = 1;
+  const bool parallel = n_threads > 1 && int64_t(n_ch) * T * n >= kParallelSamples;
   if (!parallel) {
     AlignedFloats scratch = detail::alloc_floats(n);
     std::vector<float> edge(n, 0.0f);
     iterate(0, n_ch, false, scratch.get(), edge.data());
   } else if (n_ch % n_threads == 0) {
-    // Whole channels per thread (e.g. binaural on 2 cores): no barrier until the end, which also
-    // keeps the speed when other processes compete for the cores.
-#pragma omp parallel
+    // Whole channels per thread (e.g. binaural on 2 cores): no barrier until the end.
+#pragma omp parallel num_threads(n_threads)
     {
       AlignedFloats scratch = detail::alloc_floats(n);
       std::vector<float> edge(n, 0.0f);
@@ -246,7 +246,7 @@ std::vector<std::vector<float>> run(const std::vector<const Matrix*>& mags, cons
       for (int c = 0; c < n_ch; ++c) iterate(c, c + 1, false, scratch.get(), edge.data());
     }
   } else {
-#pragma omp parallel
+#pragma omp parallel num_threads(n_threads)
     {
       AlignedFloats scratch = detail::alloc_floats(n);
       std::vector<float> edge(n, 0.0f);

@@ -17,6 +17,11 @@ struct GriffinLimOptions {
   bool rand_init = true;
   uint64_t seed = 0;
   std::optional<size_t> length;  // output length; default hop*(T-1)
+  // 0: automatic — the OpenMP threads, unless called inside a parallel region (callers that
+  // reconstruct many RIRs should parallelise over RIRs) or the cores are already busy (1-minute
+  // load average above the core count: barriers then cost milliseconds each). 1: this thread
+  // only. n > 1: up to n threads, always. The result is the same in every case.
+  int threads = 0;
 };
 
 // magnitude: [n_freq, n_frames] linear magnitude (power 1). Returns the waveform, length
@@ -28,8 +33,7 @@ struct GriffinLimOptions {
 // in memory order [freq][frame][re, im].
 // `length` is used inside the iterations as torchaudio does when 1 + length/hop == n_frames (the
 // only lengths torch accepts there); any other length only pads/cuts the final waveform.
-// Results do not depend on the number of OpenMP threads (frames run in parallel, sums in a fixed
-// order).
+// Results do not depend on the number of threads (frames run in parallel, sums in a fixed order).
 std::vector<float> griffin_lim(const Matrix& magnitude, const StftParams& p,
                                const GriffinLimOptions& options = {});
 

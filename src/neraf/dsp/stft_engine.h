@@ -64,6 +64,12 @@ class StftEngine {
   fftwf_plan r2c_, c2r_;
 };
 
+// Whether the cores look busy with other work (1-minute load average above the number of cores
+// OpenMP may use). Parallel regions are then skipped where they synchronise often: a thread
+// waiting at a barrier for a descheduled partner costs milliseconds per barrier (measured: a
+// 2-thread Griffin-Lim took 0.8 s instead of 4 ms at load 10 on 2 cores).
+bool cores_busy();
+
 // Throws neraf::Error when windows at this hop leave gaps (NOLA fails): no inverse STFT exists.
 void validate_nola(const StftEngine& e);
 

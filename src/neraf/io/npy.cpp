@@ -57,8 +57,9 @@ std::vector<int64_t> parse_shape(const std::string& path, const std::string& tex
       char* end = nullptr;
       errno = 0;
       const long long v = std::strtoll(item.c_str(), &end, 10);
-      require(errno == 0 && end && *end == '\0' && v >= 0,
-              path + ": malformed .npy header (shape " + text + "); re-save the array with numpy.save");
+      require(
+          errno == 0 && end && *end == '\0' && v >= 0,
+          path + ": malformed .npy header (shape " + text + "); re-save the array with numpy.save");
       shape.push_back(v);
     }
     pos = comma + 1;
@@ -121,8 +122,9 @@ NpyHeader read_npy_header(const std::string& path) {
                 "' is not supported (need little-endian float32 '<f4' or float64 '<f8'); convert "
                 "it with arr.astype('<f4')");
   }
-  require(fortran == "False", path + ": .npy array is in Fortran order; re-save it with "
-                                     "numpy.save(path, np.ascontiguousarray(arr))");
+  require(fortran == "False", path +
+                                  ": .npy array is in Fortran order; re-save it with "
+                                  "numpy.save(path, np.ascontiguousarray(arr))");
   h.shape = parse_shape(path, shape_text);
   h.data_offset = prefix + header_len;
 

@@ -72,16 +72,15 @@ class HashGridFunction : public torch::autograd::Function<HashGridFunction> {
     torch::Tensor table = need_x ? saved[1].contiguous() : torch::Tensor();
     const int nt = at::get_num_threads();
     if (grad_out.scalar_type() == torch::kFloat32) {
-      hash_grid_backward_cpu<float>(x.data_ptr<float>(), n,
-                                    need_x ? table.data_ptr<float>() : nullptr,
-                                    grad_out.data_ptr<float>(), layout, grad_table.data_ptr<float>(),
-                                    need_x ? grad_x.data_ptr<float>() : nullptr, nt);
+      hash_grid_backward_cpu<float>(
+          x.data_ptr<float>(), n, need_x ? table.data_ptr<float>() : nullptr,
+          grad_out.data_ptr<float>(), layout, grad_table.data_ptr<float>(),
+          need_x ? grad_x.data_ptr<float>() : nullptr, nt);
     } else {
-      hash_grid_backward_cpu<double>(x.data_ptr<double>(), n,
-                                     need_x ? table.data_ptr<double>() : nullptr,
-                                     grad_out.data_ptr<double>(), layout,
-                                     grad_table.data_ptr<double>(),
-                                     need_x ? grad_x.data_ptr<double>() : nullptr, nt);
+      hash_grid_backward_cpu<double>(
+          x.data_ptr<double>(), n, need_x ? table.data_ptr<double>() : nullptr,
+          grad_out.data_ptr<double>(), layout, grad_table.data_ptr<double>(),
+          need_x ? grad_x.data_ptr<double>() : nullptr, nt);
     }
     return {grad_x, need_table ? grad_table : torch::Tensor(), torch::Tensor()};
   }
@@ -159,11 +158,11 @@ torch::Tensor hash_grid_encode_reference(const torch::Tensor& x, const torch::Te
     weights.push_back(torch::stack(level_weights, 1));
   }
   // One gather for everything (one gradient buffer for the table in the backward pass).
-  const torch::Tensor all_rows = torch::stack(rows, 0).reshape({-1});          // [L·N·8]
+  const torch::Tensor all_rows = torch::stack(rows, 0).reshape({-1});  // [L·N·8]
   const torch::Tensor vals = table.index_select(0, all_rows).reshape({L, n, 8, F});
-  const torch::Tensor w = torch::stack(weights, 0).to(table.scalar_type());   // [L, N, 8]
-  const torch::Tensor out = (w.unsqueeze(3) * vals).sum(2);                    // [L, N, F]
-  return out.permute({1, 0, 2}).reshape({n, L * F});                           // [N, L·F]
+  const torch::Tensor w = torch::stack(weights, 0).to(table.scalar_type());  // [L, N, 8]
+  const torch::Tensor out = (w.unsqueeze(3) * vals).sum(2);                  // [L, N, F]
+  return out.permute({1, 0, 2}).reshape({n, L * F});                         // [N, L·F]
 }
 
 HashGridImpl::HashGridImpl(HashGridConfig config, uint64_t seed)
@@ -175,8 +174,6 @@ HashGridImpl::HashGridImpl(HashGridConfig config, uint64_t seed)
   table = register_parameter("table", t);
 }
 
-torch::Tensor HashGridImpl::forward(torch::Tensor x) {
-  return hash_grid_encode(x, table, layout_);
-}
+torch::Tensor HashGridImpl::forward(torch::Tensor x) { return hash_grid_encode(x, table, layout_); }
 
 }  // namespace neraf::nerf

@@ -17,9 +17,10 @@ namespace neraf::nerf {
 //        when the table is float64, for finite-difference tests)
 // table: [layout.total_entries, F], same dtype and device as x
 // returns [N, L·F] (features of level 0, then level 1, ...), same dtype as the table.
-// Gradients: w.r.t. the table always; w.r.t. x only when x.requires_grad() (Nerfacto's camera
-// optimizer moves sample positions, so the positions can need it; it costs one more gather per
-// corner in the backward pass). Not twice differentiable.
+// Gradients: w.r.t. the table always (a fresh dense [total_entries, F] tensor per backward: let
+// the optimizer zero grads with set_to_none so autograd moves it in instead of adding 48 MB);
+// w.r.t. x only when x.requires_grad() (Nerfacto's camera optimizer moves the sample positions,
+// so they need it; it costs about one more forward pass). Not twice differentiable.
 // Throws c10::Error (TORCH_CHECK) on wrong dtype, shape, device or contiguity.
 torch::Tensor hash_grid_encode(const torch::Tensor& x, const torch::Tensor& table,
                                const HashGridLayout& layout);

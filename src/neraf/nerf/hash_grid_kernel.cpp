@@ -1,6 +1,7 @@
 #include "neraf/nerf/hash_grid_kernel.h"
 
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC 12 false positives in avx512 intrinsics
+// GCC 12 reports false -Wmaybe-uninitialized inside its own AVX-512 intrinsic headers.
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include <omp.h>
 
 #if defined(__AVX512F__)
@@ -12,7 +13,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <memory>
 #include <string>
 #include <type_traits>
@@ -29,12 +29,12 @@ HashGridLayout HashGridLayout::make(const HashGridConfig& c) {
               c.features_per_level == 8,
           where + "features_per_level must be 1, 2, 4 or 8, got " +
               std::to_string(c.features_per_level));
-  require(c.log2_hashmap_size >= 3 && c.log2_hashmap_size <= 30,
-          where + "log2_hashmap_size must be in [3, 30], got " +
-              std::to_string(c.log2_hashmap_size));
-  require(c.base_resolution >= 1 && c.base_resolution <= 1 << 16,
-          where + "base_resolution must be in [1, 65536], got " +
-              std::to_string(c.base_resolution));
+  require(
+      c.log2_hashmap_size >= 3 && c.log2_hashmap_size <= 30,
+      where + "log2_hashmap_size must be in [3, 30], got " + std::to_string(c.log2_hashmap_size));
+  require(
+      c.base_resolution >= 1 && c.base_resolution <= 1 << 16,
+      where + "base_resolution must be in [1, 65536], got " + std::to_string(c.base_resolution));
   require(c.max_resolution >= c.base_resolution && c.max_resolution <= 1 << 20,
           where + "max_resolution must be in [base_resolution, 2^20], got " +
               std::to_string(c.max_resolution));
@@ -43,11 +43,11 @@ HashGridLayout HashGridLayout::make(const HashGridConfig& c) {
   layout.config = c;
   // nerfstudio computes the growth factor in double and tcnn stores it as a float.
   layout.per_level_scale =
-      c.num_levels > 1 ? static_cast<float>(std::exp(
-                             (std::log(static_cast<double>(c.max_resolution)) -
-                              std::log(static_cast<double>(c.base_resolution))) /
-                             (c.num_levels - 1)))
-                       : 1.0f;
+      c.num_levels > 1
+          ? static_cast<float>(std::exp((std::log(static_cast<double>(c.max_resolution)) -
+                                         std::log(static_cast<double>(c.base_resolution))) /
+                                        (c.num_levels - 1)))
+          : 1.0f;
   const float log2_scale = std::log2(layout.per_level_scale);
   const uint64_t hashmap_size = uint64_t{1} << c.log2_hashmap_size;
   int64_t offset = 0;
@@ -108,7 +108,7 @@ inline void locate(const T* p, const Level& lv, uint32_t idx[8], T frac[3]) {
   }
   if (kDense) {
     const uint32_t base = g[0] + g[1] * lv.res + g[2] * lv.res2;
-    const uint32_t off[8] = {0u,      1u,          lv.res,          lv.res + 1u,
+    const uint32_t off[8] = {0u,      1u,          lv.res,           lv.res + 1u,
                              lv.res2, lv.res2 + 1, lv.res2 + lv.res, lv.res2 + lv.res + 1u};
     for (int c = 0; c < 8; ++c) {
       const uint32_t v = base + off[c];
@@ -164,11 +164,11 @@ inline void scatter_point(const uint32_t idx[8], const T w[8], const T* g, T* gr
   }
 }
 
-// This level's contribution to dL/dx of one point:
+// Adds this level's contribution to dL/dx of one point (assigns it when `first`):
 // scale · Σ_c (±1) · (product of the other two 1-D weights) · Σ_f g_f · v_cf.
 template <typename T, int F>
 inline void grad_x_point(const uint32_t idx[8], const T frac[3], const T* g, const T* table,
-                         T scale, T* gx) {
+                         T scale, bool first, T* gx) {
   const T wx[2] = {T(1) - frac[0], frac[0]};
   const T wy[2] = {T(1) - frac[1], frac[1]};
   const T wz[2] = {T(1) - frac[2], frac[2]};
@@ -183,7 +183,7 @@ inline void grad_x_point(const uint32_t idx[8], const T frac[3], const T* g, con
     d[1] = std::fma(by ? txz : -txz, gv, d[1]);
     d[2] = std::fma(bz ? txy : -txy, gv, d[2]);
   }
-  for (int k = 0; k < 3; ++k) gx[k] = scale * d[k];
+  for (int k = 0; k < 3; ++k) gx[k] = first ? scale * d[k] : std::fma(scale, d[k], gx[k]);
 }
 
 // out_level: [n, F] rows of this level (level-major scratch); points [begin, end).
@@ -199,21 +199,30 @@ void forward_level_scalar(const T* x, int64_t begin, int64_t end, const T* table
   }
 }
 
-// grad_level: [n, F] upstream gradient of this level (level-major scratch); grad_x_level: [n, 3]
-// this level's contribution to dL/dx, or null. Points [begin, end) in order.
+// grad_level: [n, F] upstream gradient of this level (level-major scratch). Points [begin, end)
+// in order.
 template <typename T, int F, bool kDense>
-void backward_level_scalar(const T* x, int64_t begin, int64_t end, const T* table,
-                           const T* grad_level, const Level& lv, T* grad_table, T* grad_x_level) {
+void scatter_level_scalar(const T* x, int64_t begin, int64_t end, const T* grad_level,
+                          const Level& lv, T* grad_table) {
   for (int64_t i = begin; i < end; ++i) {
     uint32_t idx[8];
     T frac[3], w[8];
     locate<T, kDense>(x + 3 * i, lv, idx, frac);
     weights(frac, w);
-    const T* g = grad_level + i * F;
-    scatter_point<T, F>(idx, w, g, grad_table);
-    if (grad_x_level != nullptr) {
-      grad_x_point<T, F>(idx, frac, g, table, static_cast<T>(lv.scale), grad_x_level + 3 * i);
-    }
+    scatter_point<T, F>(idx, w, grad_level + i * F, grad_table);
+  }
+}
+
+// grad_x: [n, 3], this level's contribution added (assigned when `first`).
+template <typename T, int F, bool kDense>
+void grad_x_level_scalar(const T* x, int64_t begin, int64_t end, const T* table,
+                         const T* grad_level, const Level& lv, bool first, T* grad_x) {
+  for (int64_t i = begin; i < end; ++i) {
+    uint32_t idx[8];
+    T frac[3];
+    locate<T, kDense>(x + 3 * i, lv, idx, frac);
+    grad_x_point<T, F>(idx, frac, grad_level + i * F, table, static_cast<T>(lv.scale), first,
+                       grad_x + 3 * i);
   }
 }
 
@@ -224,7 +233,7 @@ void backward_level_scalar(const T* x, int64_t begin, int64_t end, const T* tabl
 struct XyzPermutes {
   alignas(64) int32_t first[3][16];   // picks from the first 32 floats
   alignas(64) int32_t second[3][16];  // keeps lanes < 32 / picks the rest from the last 16
-  XyzPermutes() {
+  constexpr XyzPermutes() : first{}, second{} {
     for (int k = 0; k < 3; ++k) {
       for (int j = 0; j < 16; ++j) {
         const int e = 3 * j + k;
@@ -234,7 +243,7 @@ struct XyzPermutes {
     }
   }
 };
-const XyzPermutes kXyz;
+constexpr XyzPermutes kXyz{};
 
 inline __m512 load_component(const __m512 a, const __m512 b, const __m512 c, int k) {
   const __m512 t = _mm512_permutex2var_ps(a, _mm512_load_si512(kXyz.first[k]), b);
@@ -244,8 +253,7 @@ inline __m512 load_component(const __m512 a, const __m512 b, const __m512 c, int
 // The 8 corner rows, weights and fractions of 16 points (x: 48 floats). Returns false when a dense
 // index needs a true modulo (inputs far outside [0,1]); the caller then uses the scalar path.
 template <bool kDense>
-inline bool locate16(const float* x, const Level& lv, __m512i idx[8], __m512 w[8],
-                     __m512 frac[3]) {
+inline bool locate16(const float* x, const Level& lv, __m512i idx[8], __m512 w[8], __m512 frac[3]) {
   const __m512 a = _mm512_loadu_ps(x), b = _mm512_loadu_ps(x + 16), c = _mm512_loadu_ps(x + 32);
   const __m512 scale = _mm512_set1_ps(lv.scale), half = _mm512_set1_ps(0.5f);
   __m512i g[3];
@@ -297,16 +305,13 @@ inline bool locate16(const float* x, const Level& lv, __m512i idx[8], __m512 w[8
 
 // Gathers the (f0, f1) pairs of 16 rows as two vectors of 8 interleaved pairs.
 inline void gather_pairs(const float* table, __m512i idx, __m512& lo, __m512& hi) {
-  lo = _mm512_castsi512_ps(
-      _mm512_i32gather_epi64(_mm512_castsi512_si256(idx), table, 8));
-  hi = _mm512_castsi512_ps(
-      _mm512_i32gather_epi64(_mm512_extracti64x4_epi64(idx, 1), table, 8));
+  lo = _mm512_castsi512_ps(_mm512_i32gather_epi64(_mm512_castsi512_si256(idx), table, 8));
+  hi = _mm512_castsi512_ps(_mm512_i32gather_epi64(_mm512_extracti64x4_epi64(idx, 1), table, 8));
 }
 
 // Lane j of a 16-vector repeated twice: lanes (0,0,1,1,...,7,7) and (8,8,...,15,15).
 inline __m512 spread_lo(__m512 v) {
-  return _mm512_permutexvar_ps(
-      _mm512_set_epi32(7, 7, 6, 6, 5, 5, 4, 4, 3, 3, 2, 2, 1, 1, 0, 0), v);
+  return _mm512_permutexvar_ps(_mm512_set_epi32(7, 7, 6, 6, 5, 5, 4, 4, 3, 3, 2, 2, 1, 1, 0, 0), v);
 }
 inline __m512 spread_hi(__m512 v) {
   return _mm512_permutexvar_ps(
@@ -345,21 +350,19 @@ struct ScatterBlock {
 };
 
 template <bool kDense>
-void backward_level_avx512(const float* x, int64_t begin, int64_t end, const float* table,
-                           const float* grad_level, const Level& lv, float* grad_table,
-                           float* grad_x_level) {
-  // Software pipeline: block b + kAhead is located (and its dL/dx computed) and its gradient rows
-  // prefetched for writing while block b is scattered. The scatter is a read-modify-write of
-  // random rows; without the prefetch the store queue fills up behind cache misses.
+void scatter_level_avx512(const float* x, int64_t begin, int64_t end, const float* grad_level,
+                          const Level& lv, float* grad_table) {
+  // Software pipeline: block b + kAhead is located and its gradient rows prefetched for writing
+  // while block b is scattered. The scatter is a read-modify-write of random rows; without the
+  // prefetch the store queue fills up behind cache misses.
   constexpr int kAhead = 2;
   ScatterBlock ring[kAhead + 1];
   const int64_t n_blocks = (end - begin) / 16;
 
   auto prepare = [&](int64_t b, ScatterBlock& blk) {
-    const int64_t i = begin + 16 * b;
     __m512i idx[8];
     __m512 w[8], frac[3];
-    blk.simd = locate16<kDense>(x + 3 * i, lv, idx, w, frac);
+    blk.simd = locate16<kDense>(x + 3 * (begin + 16 * b), lv, idx, w, frac);
     if (!blk.simd) return;
     for (int k = 0; k < 8; ++k) {
       _mm512_store_si512(blk.idx[k], idx[k]);
@@ -370,15 +373,50 @@ void backward_level_avx512(const float* x, int64_t begin, int64_t end, const flo
         __builtin_prefetch(grad_table + 2 * static_cast<int64_t>(blk.idx[k][j]), 1, 3);
       }
     }
-    if (grad_x_level == nullptr) return;
-    // Same operation sequence as grad_x_point, 16 lanes at a time.
+  };
+
+  for (int64_t b = 0; b < std::min<int64_t>(kAhead, n_blocks); ++b) prepare(b, ring[b]);
+  for (int64_t b = 0; b < n_blocks; ++b) {
+    if (b + kAhead < n_blocks) prepare(b + kAhead, ring[(b + kAhead) % (kAhead + 1)]);
+    const ScatterBlock& blk = ring[b % (kAhead + 1)];
+    const int64_t i = begin + 16 * b;
+    if (!blk.simd) {
+      scatter_level_scalar<float, 2, kDense>(x, i, i + 16, grad_level, lv, grad_table);
+      continue;
+    }
+    // The scatter stays scalar and in point order: that order makes the sums deterministic (and
+    // identical to the scalar path).
+    for (int j = 0; j < 16; ++j) {
+      const float* g = grad_level + 2 * (i + j);
+      for (int k = 0; k < 8; ++k) {
+        float* dst = grad_table + 2 * static_cast<int64_t>(blk.idx[k][j]);
+        dst[0] = std::fma(blk.w[k][j], g[0], dst[0]);
+        dst[1] = std::fma(blk.w[k][j], g[1], dst[1]);
+      }
+    }
+  }
+  scatter_level_scalar<float, 2, kDense>(x, begin + 16 * n_blocks, end, grad_level, lv, grad_table);
+}
+
+// Same operation sequence as grad_x_level_scalar, 16 points at a time.
+template <bool kDense>
+void grad_x_level_avx512(const float* x, int64_t begin, int64_t end, const float* table,
+                         const float* grad_level, const Level& lv, bool first, float* grad_x) {
+  const __m512i even = _mm512_set_epi32(30, 28, 26, 24, 22, 20, 18, 16, 14, 12, 10, 8, 6, 4, 2, 0);
+  const __m512 one = _mm512_set1_ps(1.0f);
+  const __m512 scale = _mm512_set1_ps(lv.scale);
+  int64_t i = begin;
+  for (; i + 16 <= end; i += 16) {
+    __m512i idx[8];
+    __m512 w[8], frac[3];
+    if (!locate16<kDense>(x + 3 * i, lv, idx, w, frac)) {
+      grad_x_level_scalar<float, 2, kDense>(x, i, i + 16, table, grad_level, lv, first, grad_x);
+      continue;
+    }
     const __m512 g_lo = _mm512_loadu_ps(grad_level + 2 * i);
     const __m512 g_hi = _mm512_loadu_ps(grad_level + 2 * i + 16);
     const __m512 g_lo_sw = _mm512_permute_ps(g_lo, 0xB1);
     const __m512 g_hi_sw = _mm512_permute_ps(g_hi, 0xB1);
-    const __m512i even =
-        _mm512_set_epi32(30, 28, 26, 24, 22, 20, 18, 16, 14, 12, 10, 8, 6, 4, 2, 0);
-    const __m512 one = _mm512_set1_ps(1.0f);
     const __m512 wx[2] = {_mm512_sub_ps(one, frac[0]), frac[0]};
     const __m512 wy[2] = {_mm512_sub_ps(one, frac[1]), frac[1]};
     const __m512 wz[2] = {_mm512_sub_ps(one, frac[2]), frac[2]};
@@ -400,38 +438,22 @@ void backward_level_avx512(const float* x, int64_t begin, int64_t end, const flo
       d[1] = by ? _mm512_fmadd_ps(txz, gv, d[1]) : _mm512_fnmadd_ps(txz, gv, d[1]);
       d[2] = bz ? _mm512_fmadd_ps(txy, gv, d[2]) : _mm512_fnmadd_ps(txy, gv, d[2]);
     }
+    // Interleave the three component vectors back to 16 xyz triples.
     alignas(64) float d_s[3][16];
-    const __m512 scale = _mm512_set1_ps(lv.scale);
-    for (int k = 0; k < 3; ++k) _mm512_store_ps(d_s[k], _mm512_mul_ps(scale, d[k]));
-    float* gx = grad_x_level + 3 * i;
-    for (int j = 0; j < 16; ++j) {
-      for (int k = 0; k < 3; ++k) gx[3 * j + k] = d_s[k][j];
-    }
-  };
-
-  for (int64_t b = 0; b < std::min<int64_t>(kAhead, n_blocks); ++b) prepare(b, ring[b]);
-  for (int64_t b = 0; b < n_blocks; ++b) {
-    if (b + kAhead < n_blocks) prepare(b + kAhead, ring[(b + kAhead) % (kAhead + 1)]);
-    const ScatterBlock& blk = ring[b % (kAhead + 1)];
-    const int64_t i = begin + 16 * b;
-    if (!blk.simd) {
-      backward_level_scalar<float, 2, kDense>(x, i, i + 16, table, grad_level, lv, grad_table,
-                                              grad_x_level);
-      continue;
-    }
-    // The scatter stays scalar and in point order: that order makes the sums deterministic (and
-    // identical to the scalar path).
-    for (int j = 0; j < 16; ++j) {
-      const float* g = grad_level + 2 * (i + j);
-      for (int k = 0; k < 8; ++k) {
-        float* dst = grad_table + 2 * static_cast<int64_t>(blk.idx[k][j]);
-        dst[0] = std::fma(blk.w[k][j], g[0], dst[0]);
-        dst[1] = std::fma(blk.w[k][j], g[1], dst[1]);
+    float* gx = grad_x + 3 * i;
+    if (first) {
+      for (int k = 0; k < 3; ++k) _mm512_store_ps(d_s[k], _mm512_mul_ps(scale, d[k]));
+      for (int j = 0; j < 16; ++j) {
+        for (int k = 0; k < 3; ++k) gx[3 * j + k] = d_s[k][j];
+      }
+    } else {
+      for (int k = 0; k < 3; ++k) _mm512_store_ps(d_s[k], d[k]);
+      for (int j = 0; j < 16; ++j) {
+        for (int k = 0; k < 3; ++k) gx[3 * j + k] = std::fma(lv.scale, d_s[k][j], gx[3 * j + k]);
       }
     }
   }
-  backward_level_scalar<float, 2, kDense>(x, begin + 16 * n_blocks, end, table, grad_level, lv,
-                                          grad_table, grad_x_level);
+  grad_x_level_scalar<float, 2, kDense>(x, i, end, table, grad_level, lv, first, grad_x);
 }
 #endif  // NERAF_HASH_GRID_AVX512
 
@@ -448,17 +470,27 @@ void forward_level(const T* x, int64_t begin, int64_t end, const T* table, const
 }
 
 template <typename T, int F, bool kDense>
-void backward_level(const T* x, int64_t n, const T* table, const T* grad_level, const Level& lv,
-                    T* grad_table, T* grad_x_level, bool simd) {
+void scatter_level(const T* x, int64_t n, const T* grad_level, const Level& lv, T* grad_table,
+                   bool simd) {
+#if NERAF_HASH_GRID_AVX512
+  if constexpr (std::is_same_v<T, float> && F == 2) {
+    if (simd) return scatter_level_avx512<kDense>(x, 0, n, grad_level, lv, grad_table);
+  }
+#endif
+  scatter_level_scalar<T, F, kDense>(x, 0, n, grad_level, lv, grad_table);
+}
+
+template <typename T, int F, bool kDense>
+void grad_x_level(const T* x, int64_t begin, int64_t end, const T* table, const T* grad_level,
+                  const Level& lv, bool first, T* grad_x, bool simd) {
 #if NERAF_HASH_GRID_AVX512
   if constexpr (std::is_same_v<T, float> && F == 2) {
     if (simd) {
-      return backward_level_avx512<kDense>(x, 0, n, table, grad_level, lv, grad_table,
-                                           grad_x_level);
+      return grad_x_level_avx512<kDense>(x, begin, end, table, grad_level, lv, first, grad_x);
     }
   }
 #endif
-  backward_level_scalar<T, F, kDense>(x, 0, n, table, grad_level, lv, grad_table, grad_x_level);
+  grad_x_level_scalar<T, F, kDense>(x, begin, end, table, grad_level, lv, first, grad_x);
 }
 
 // Row block of F values, copied as one unit by the transposes.
@@ -539,34 +571,40 @@ void backward_impl(const T* x, int64_t n, const T* table, const T* grad_out,
   const int nt = threads_for(n, num_threads);
   std::unique_ptr<T[]> grad_lm(new T[static_cast<size_t>(n) * L * F]);
   point_major_to_level_major<T, F>(grad_out, n, L, grad_lm.get(), nt);
-  std::unique_ptr<T[]> grad_x_levels;
-  if (grad_x != nullptr) grad_x_levels.reset(new T[static_cast<size_t>(n) * L * 3]);
 
-  // Each level is owned by exactly one thread and accumulated in point order, so the result does
-  // not depend on which thread takes it: dynamic scheduling (finest, most expensive levels first)
-  // balances the load without costing determinism.
+  // Table gradient. Each level is owned by exactly one thread and accumulated in point order, so
+  // the result does not depend on which thread takes it: dynamic scheduling (finest, most
+  // expensive levels first) balances the load without costing determinism.
 #pragma omp parallel for schedule(dynamic, 1) num_threads(std::min(nt, L))
   for (int k = 0; k < L; ++k) {
     const int l = L - 1 - k;
     const Level lv = level_of(layout, l);
     const int64_t off = layout.offsets[l] * F;
     const T* gl = grad_lm.get() + static_cast<int64_t>(l) * n * F;
-    T* gxl = grad_x != nullptr ? grad_x_levels.get() + static_cast<int64_t>(l) * n * 3 : nullptr;
-    const T* tl = table != nullptr ? table + off : nullptr;  // only read for dL/dx
     if (layout.dense[l]) {
-      backward_level<T, F, true>(x, n, tl, gl, lv, grad_table + off, gxl, simd);
+      scatter_level<T, F, true>(x, n, gl, lv, grad_table + off, simd);
     } else {
-      backward_level<T, F, false>(x, n, tl, gl, lv, grad_table + off, gxl, simd);
+      scatter_level<T, F, false>(x, n, gl, lv, grad_table + off, simd);
     }
   }
+  if (grad_x == nullptr) return;
 
-  if (grad_x != nullptr) {
-    const T* gxl = grad_x_levels.get();
-#pragma omp parallel for schedule(static) num_threads(nt)
-    for (int64_t i = 0; i < n * 3; ++i) {
-      T s = T(0);
-      for (int l = 0; l < L; ++l) s += gxl[static_cast<int64_t>(l) * n * 3 + i];
-      grad_x[i] = s;
+    // Position gradient: like the forward pass (level-outer, points split across threads), summed
+    // over levels in level order, so again independent of the thread count.
+#pragma omp parallel num_threads(nt)
+  {
+    const int tid = omp_get_thread_num(), nth = omp_get_num_threads();
+    const int64_t begin = n * tid / nth, end = n * (tid + 1) / nth;
+    for (int l = 0; l < L; ++l) {
+      const Level lv = level_of(layout, l);
+      const T* tl = table + layout.offsets[l] * F;
+      const T* gl = grad_lm.get() + static_cast<int64_t>(l) * n * F;
+      if (layout.dense[l]) {
+        grad_x_level<T, F, true>(x, begin, end, tl, gl, lv, l == 0, grad_x, simd);
+      } else {
+        grad_x_level<T, F, false>(x, begin, end, tl, gl, lv, l == 0, grad_x, simd);
+      }
+#pragma omp barrier
     }
   }
 }
@@ -581,17 +619,21 @@ void hash_grid_forward_cpu(const T* x, int64_t n, const T* table, const HashGrid
   if (n <= 0) return;
   const bool simd = path == HashGridPath::kBest;
   switch (layout.features()) {
-    case 1: return forward_impl<T, 1>(x, n, table, layout, out, num_threads, simd);
-    case 2: return forward_impl<T, 2>(x, n, table, layout, out, num_threads, simd);
-    case 4: return forward_impl<T, 4>(x, n, table, layout, out, num_threads, simd);
-    case 8: return forward_impl<T, 8>(x, n, table, layout, out, num_threads, simd);
+    case 1:
+      return forward_impl<T, 1>(x, n, table, layout, out, num_threads, simd);
+    case 2:
+      return forward_impl<T, 2>(x, n, table, layout, out, num_threads, simd);
+    case 4:
+      return forward_impl<T, 4>(x, n, table, layout, out, num_threads, simd);
+    case 8:
+      return forward_impl<T, 8>(x, n, table, layout, out, num_threads, simd);
   }
 }
 
 template <typename T>
 void hash_grid_backward_cpu(const T* x, int64_t n, const T* table, const T* grad_out,
-                            const HashGridLayout& layout, T* grad_table, T* grad_x,
-                            int num_threads, HashGridPath path) {
+                            const HashGridLayout& layout, T* grad_table, T* grad_x, int num_threads,
+                            HashGridPath path) {
   if (n <= 0) return;
   const bool simd = path == HashGridPath::kBest;
   switch (layout.features()) {

@@ -22,11 +22,11 @@
 namespace neraf::nerf {
 
 struct HashGridConfig {
-  int num_levels = 16;          // L
-  int features_per_level = 2;   // F: 1, 2, 4 or 8
-  int log2_hashmap_size = 19;   // T = 2^19 rows per hashed level
-  int base_resolution = 16;     // vertices per side of level 0 (tcnn: scale_0 = base − 1)
-  int max_resolution = 2048;    // only used to derive per_level_scale, as nerfstudio does
+  int num_levels = 16;         // L
+  int features_per_level = 2;  // F: 1, 2, 4 or 8
+  int log2_hashmap_size = 19;  // T = 2^19 rows per hashed level
+  int base_resolution = 16;    // vertices per side of level 0 (tcnn: scale_0 = base − 1)
+  int max_resolution = 2048;   // only used to derive per_level_scale, as nerfstudio does
 };
 
 // Everything the kernels need to know about the table, derived once from a config.
@@ -68,10 +68,11 @@ void hash_grid_forward_cpu(const T* x, int64_t n, const T* table, const HashGrid
 
 // Gradient w.r.t. the table, ACCUMULATED into grad_table ([total_entries, F]; zero it first for a
 // plain gradient). grad_out: [n, L·F]. Levels are owned by threads (no atomics); within a level
-// points are accumulated in index order, so the bits do not depend on num_threads.
-// If grad_x is not null ([n, 3], overwritten) the gradient w.r.t. x is computed in the same pass
-// (needs `table`, which may be null otherwise; summed over levels in level order, also
-// thread-count independent).
+// points are accumulated in index order, so the bits do not depend on num_threads. With 2 threads
+// and 16 levels each thread owns 8 levels; there is no parallelism beyond L threads.
+// If grad_x is not null ([n, 3], overwritten) the gradient w.r.t. x is computed too, in a second
+// pass shaped like the forward one (needs `table`, which may be null otherwise; summed over levels
+// in level order, also thread-count independent). It costs about one more forward pass.
 template <typename T>
 void hash_grid_backward_cpu(const T* x, int64_t n, const T* table, const T* grad_out,
                             const HashGridLayout& layout, T* grad_table, T* grad_x, int num_threads,

@@ -1,8 +1,7 @@
 #include "neraf/nerf/sh_encoding.h"
 
-#include <torch/torch.h>
-
 #include <ATen/Parallel.h>
+#include <torch/torch.h>
 
 #include <algorithm>
 
@@ -66,20 +65,20 @@ inline void sh_vjp(T x, T y, T z, const T* g, int count, T* d) {
     dy -= T(2 * kC2d) * y * g[8];
   }
   if (count > 9) {
-    dx += T(-6 * kC3a) * x * y * g[9];                    // Y9 = a(−3x²y + y³)
+    dx += T(-6 * kC3a) * x * y * g[9];  // Y9 = a(−3x²y + y³)
     dy += T(3 * kC3a) * (y2 - x2) * g[9];
-    dx += T(kC3b) * y * z * g[10];                        // Y10 = b·xyz
+    dx += T(kC3b) * y * z * g[10];  // Y10 = b·xyz
     dy += T(kC3b) * x * z * g[10];
     dz += T(kC3b) * x * y * g[10];
-    dy += T(kC3c) * (T(1) - T(5) * z2) * g[11];           // Y11 = c·y(1 − 5z²)
+    dy += T(kC3c) * (T(1) - T(5) * z2) * g[11];  // Y11 = c·y(1 − 5z²)
     dz += T(-10 * kC3c) * y * z * g[11];
-    dz += T(kC3d) * (T(15) * z2 - T(3)) * g[12];          // Y12 = d(5z³ − 3z)
-    dx += T(kC3c) * (T(1) - T(5) * z2) * g[13];           // Y13 = c·x(1 − 5z²)
+    dz += T(kC3d) * (T(15) * z2 - T(3)) * g[12];  // Y12 = d(5z³ − 3z)
+    dx += T(kC3c) * (T(1) - T(5) * z2) * g[13];   // Y13 = c·x(1 − 5z²)
     dz += T(-10 * kC3c) * x * z * g[13];
-    dx += T(2 * kC3e) * x * z * g[14];                    // Y14 = e·z(x² − y²)
+    dx += T(2 * kC3e) * x * z * g[14];  // Y14 = e·z(x² − y²)
     dy += T(-2 * kC3e) * y * z * g[14];
     dz += T(kC3e) * (x2 - y2) * g[14];
-    dx += T(3 * kC3a) * (y2 - x2) * g[15];                // Y15 = a(−x³ + 3xy²)
+    dx += T(3 * kC3a) * (y2 - x2) * g[15];  // Y15 = a(−x³ + 3xy²)
     dy += T(6 * kC3a) * x * y * g[15];
   }
   d[0] = dx;

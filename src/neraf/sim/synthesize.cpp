@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <memory>
 #include <numeric>
+#include <set>
 
 #include "neraf/io/atomic_file.h"
 #include "neraf/io/json_file.h"
@@ -179,6 +180,17 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
   }
 
   std::vector<double> peaks(plan.jobs.size(), 0.0);
+  {
+    // Folders first, serially, so the parallel writers never race on creating them.
+    std::set<fs::path> dirs;
+    for (const auto& job : plan.jobs) dirs.insert((root / job.file).parent_path());
+    for (const auto& d : dirs) {
+      std::error_code ec;
+      fs::create_directories(d, ec);
+      require(!ec, d.string() + ": cannot create the folder (" + ec.message() +
+                       "); choose a writable --out");
+    }
+  }
   {
     popt.unit = "RIR";
     Progress progress(plan.binaural ? "binaural RIRs" : "RIRs", sum.num_rirs, popt);

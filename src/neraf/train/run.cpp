@@ -3,10 +3,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 
 #include "neraf/io/json_file.h"
+#include "neraf/train/audio_run.h"
 #include "neraf/train/checkpoint.h"
 #include "neraf/train/trainer.h"
 #include "neraf/util/error.h"
@@ -139,7 +141,7 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
     cfg = train_config_from_json(io::read_json(config_path), config_path);
     if (options.steps) {
       // Schedules whose decay was tied to the run length follow the new length.
-      for (ScheduleConfig* s : {&cfg.fields, &cfg.proposal_networks})
+      for (ScheduleConfig* s : {&cfg.fields, &cfg.proposal_networks, &cfg.audio.schedule})
         if (s->max_steps == cfg.steps) s->max_steps = *options.steps;
       cfg.steps = *options.steps;
     }
@@ -164,17 +166,27 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
   if (data_dir.empty() && old_manifest.contains("data")) data_dir = old_manifest["data"];
   require(!data_dir.empty(), "--data: required (the dataset folder or its transforms.json)");
   const data::ImageSet images = data::load_transforms_json(data_dir);
-  const nlohmann::json manifest = make_data_manifest(images, data_dir);
+  nlohmann::json manifest = make_data_manifest(images, data_dir);
   if (!old_manifest.is_null() && resume_from) {
     for (const char* key : {"num_train", "height", "width", "train_files"})
       require(old_manifest.value(key, nlohmann::json()) == manifest[key],
               data_dir + ": differs from the dataset this run was trained on (" + key +
                   "); resume with the original --data");
   }
+  // The acoustic branch's RIRs (features cached next to the dataset) and their manifest.
+  std::unique_ptr<data::RirSet> rirs;
+  if (cfg.modality != Modality::vision) {
+    data::RirLoadOptions rload;
+    rload.progress = options.progress;
+    rirs = std::make_unique<data::RirSet>(data::load_rir_set(data_dir, rload));
+    if (!old_manifest.is_null() && resume_from && old_manifest.contains("audio"))
+      check_audio_manifest(old_manifest["audio"], *rirs, data_dir);
+    manifest["audio"] = make_audio_manifest(*rirs);
+  }
   io::write_json_atomically(config_path, to_json(cfg));
   io::write_json_atomically(manifest_path, manifest);
 
-  std::unique_ptr<Trainer> trainer = make_trainer(cfg, &images, options.device);
+  std::unique_ptr<Trainer> trainer = make_trainer(cfg, &images, options.device, rirs.get());
   if (resume_from) {
     trainer->load_checkpoint(*resume_from);
     info("resuming " + options.run_dir + " from step " +
@@ -219,9 +231,17 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     summary.seconds = elapsed;
     summary.rays_per_s = elapsed > 0 ? rays / elapsed : 0;
-    char status[160];
+    if (r.metrics.count("audio_sl"))  // running mean of the audio log-magnitude MSE
+      summary.last_audio_sl = summary.last_audio_sl == 0
+                                  ? r.metrics.at("audio_sl")
+                                  : 0.98 * summary.last_audio_sl + 0.02 * r.metrics.at("audio_sl");
+    char status[200];
     std::snprintf(status, sizeof status, "step %lld  loss %.4f  PSNR %.2f  %.0f rays/s",
                   static_cast<long long>(r.step), r.loss, summary.last_psnr, summary.rays_per_s);
+    if (summary.last_audio_sl > 0) {
+      const size_t len = std::strlen(status);
+      std::snprintf(status + len, sizeof status - len, "  audio SL %.4f", summary.last_audio_sl);
+    }
     progress.update(r.step - summary.start_step, status);
 
     const bool done = r.step >= cfg.steps;

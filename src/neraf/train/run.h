@@ -38,6 +38,7 @@ struct TrainRunSummary {
   double rays_per_s = 0;
   double last_loss = 0;
   double last_psnr = 0;      // training-batch PSNR, mean over the last 50 steps
+  double last_audio_sl = 0;  // audio log-magnitude MSE (running mean; 0 before audio starts)
   bool interrupted = false;
   std::string checkpoint;    // the last checkpoint written
 };

@@ -34,6 +34,11 @@ TrainConfig train_preset(const std::string& name) {
     c.steps = 30000;  // nerfstudio's nerfacto; NeRAF runs 400k joint steps
     c.rays_per_batch = 4096;
     c.save_every = 2000;
+    // NeRAF: 128³ grid, 4096 cells per step, 2048 audio slices per step from step 2001.
+    c.audio.grid_resolution = 128;
+    c.audio.cells_per_update = 4096;
+    c.audio.batch_size = 2048;
+    c.audio.start_step = 2000;
     return c;
   }
   // cpu: a few thousand steps. The learning rate decays over the run itself (nerfstudio's
@@ -45,6 +50,14 @@ TrainConfig train_preset(const std::string& name) {
   c.fields.lr_final = 1e-3;
   c.proposal_networks.max_steps = c.steps;
   c.proposal_networks.lr_final = 1e-3;
+  // Acoustic branch on 2 cores: a 32³ grid refreshed every 16 steps, audio from step 1500 (the
+  // radiance field is roughly in place by then) with a short warm-up and a higher LR decaying
+  // over the run (1e-4 with a 1M-step decay would barely move in ~1500 audio steps).
+  c.audio.grid_resolution = 32;
+  c.audio.cells_per_update = 2048;
+  c.audio.batch_size = 512;
+  c.audio.start_step = 1500;
+  c.audio.schedule = {1e-3, 1e-4, c.steps, 1500, 1e-8, "sine", 1e-15};
   return c;
 }
 
@@ -83,6 +96,25 @@ void validate(const TrainConfig& c, const std::string& where) {
   check_schedule(c.proposal_networks, where + ".proposal_networks");
   check_schedule(c.camera_opt, where + ".camera_opt");
   nerf::validate(c.model, where + ".model");
+  const AudioConfig& a = c.audio;
+  require(a.grid == "sampled" || a.grid == "none" || a.grid == "zeros",
+          where + ".audio.grid: use sampled, none or zeros (--grid)");
+  require(a.batch_size >= 1, where + ".audio.batch_size: must be at least 1");
+  require(a.grid_resolution >= 8, where + ".audio.grid_resolution: must be at least 8");
+  require(a.cells_per_update >= 1, where + ".audio.cells_per_update: must be at least 1");
+  require(a.nacf_width >= 0 && a.nacf_layers >= 1,
+          where + ".audio.nacf_width/nacf_layers: must be >= 0 / >= 1");
+  require(a.fraction > 0 && a.fraction <= 1, where + ".audio.fraction: must be in (0, 1] "
+                                                     "(--audio-fraction)");
+  require(a.start_step >= -1, where + ".audio.start_step: must be >= -1");
+  if (c.modality == Modality::audio)
+    require(!a.vision_run.empty(), where + ".audio.vision_run: required with --modality audio "
+                                           "(--vision-run)");
+  if (c.modality != Modality::vision)
+    require(a.start_step < c.steps, where + ".audio.start_step: audio starts after step " +
+                                        std::to_string(a.start_step) + " but the run has only " +
+                                        std::to_string(c.steps) + " steps; raise --steps");
+  check_schedule(a.schedule, where + ".audio.schedule");
 }
 
 }  // namespace neraf::train

@@ -41,6 +41,35 @@ struct ScheduleConfig {
   }
 };
 
+struct AudioConfig {
+  std::string grid = "sampled";     // sampled | none | zeros (the paper's ablations, --grid)
+  int64_t start_step = 2000;        // audio losses from the step AFTER this one (reference: 2000)
+  int64_t batch_size = 2048;        // (RIR, frame) slices per audio step
+  int64_t grid_resolution = 32;     // S (cpu 32, paper 128)
+  int64_t cells_per_update = 4096;  // grid cells written per training step (round robin)
+  int64_t nacf_width = 0;           // 0: the acoustic preset's NAcF trunk; else N layers of this
+  int64_t nacf_layers = 5;          //    width (only used when nacf_width > 0)
+  double fraction = 1.0;            // few-shot: seeded fraction of the train RIRs used (--audio-fraction)
+  std::string vision_run;           // modality audio: the finished vision run whose field is frozen
+  // "audio_fields" group: NAcF + ResNet3D (+ the radiance field in joint mode), Adam eps 1e-15,
+  // sine warm-up from 1e-8 over warmup_steps then log-linear decay (neraf-reference.md §2.3).
+  ScheduleConfig schedule{1e-4, 1e-8, 1002000, 2000, 1e-8, "sine", 1e-15};
+
+  template <class V>
+  void visit(V& v) {
+    v("grid", grid);
+    v("start_step", start_step);
+    v("batch_size", batch_size);
+    v("grid_resolution", grid_resolution);
+    v("cells_per_update", cells_per_update);
+    v("nacf_width", nacf_width);
+    v("nacf_layers", nacf_layers);
+    v("fraction", fraction);
+    v("vision_run", vision_run);
+    v("schedule", schedule);
+  }
+};
+
 struct TrainConfig {
   std::string preset = "cpu";
   Modality modality = Modality::vision;
@@ -54,7 +83,7 @@ struct TrainConfig {
   ScheduleConfig proposal_networks;  // "proposal_networks" group
   ScheduleConfig camera_opt{1e-3, 1e-4, 5000};
   nerf::ModelConfig model;
-  // The acoustic branch adds its own config struct here (and a v("audio", audio) line below).
+  AudioConfig audio;                 // the acoustic branch (modality audio / joint)
 
   template <class V>
   void visit(V& v) {
@@ -70,6 +99,7 @@ struct TrainConfig {
     v("proposal_networks", proposal_networks);
     v("camera_opt", camera_opt);
     v("model", model);
+    v("audio", audio);
   }
 };
 

@@ -7,7 +7,9 @@
 
 #include "neraf/nerf/rays.h"
 #include "neraf/nerf/samplers.h"
+#include "neraf/train/audio_branch.h"
 #include "neraf/train/checkpoint.h"
+#include "neraf/train/run.h"
 #include "neraf/train/lr_schedule.h"
 #include "neraf/util/error.h"
 
@@ -21,6 +23,8 @@ constexpr const char* kFormat = "neraf-checkpoint-1";
 nlohmann::json comparable(nlohmann::json j) {
   for (const char* k : {"steps", "threads", "save_every", "eval_rays_per_chunk"}) j.erase(k);
   if (j.contains("model")) j["model"].erase("precision");
+  // Vision runs ignore the acoustic settings (and checkpoints older than them have none).
+  if (j.value("modality", "") == "vision") j.erase("audio");
   return j;
 }
 }  // namespace
@@ -288,14 +292,27 @@ nlohmann::json check_checkpoint_header(torch::serialize::InputArchive& a, const 
 }
 
 std::unique_ptr<Trainer> make_trainer(const TrainConfig& config, const data::ImageSet* images,
-                                      torch::Device device) {
+                                      torch::Device device, const data::RirSet* rirs) {
   validate(config, "config");
   auto trainer = std::make_unique<Trainer>(config, device);
   if (config.modality != Modality::vision)
-    throw Error("--modality " + to_string(config.modality) +
-                ": the acoustic branch is not available in this build yet; use --modality vision");
+    require(rirs != nullptr, "--data: an audio/joint run needs the scene's RIRs (SoundSpaces or "
+                             "RAF layout)");
+  if (config.modality == Modality::audio) {
+    // The paper's separate training: the acoustic field on the frozen grid of a vision run.
+    require(!config.audio.vision_run.empty(),
+            "--vision-run: required with --modality audio (a finished vision or joint run)");
+    LoadedRun vision = load_run(config.audio.vision_run, device);
+    for (auto& p : vision.model->parameters()) p.set_requires_grad(false);
+    trainer->add_branch(
+        std::make_unique<AudioBranch>(config, *rirs, vision.model, /*frozen_field=*/true, device));
+    return trainer;
+  }
   require(images != nullptr, "--data: a vision run needs posed images (transforms.json)");
   trainer->add_branch(std::make_unique<VisionBranch>(config, images->train, device));
+  if (config.modality == Modality::joint)
+    trainer->add_branch(std::make_unique<AudioBranch>(config, *rirs, trainer->vision()->model(),
+                                                      /*frozen_field=*/false, device));
   return trainer;
 }
 

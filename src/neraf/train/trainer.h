@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "neraf/data/image_set.h"
+#include "neraf/data/rir_set.h"
 #include "neraf/nerf/nerfacto_model.h"
 #include "neraf/train/train_config.h"
 
@@ -141,10 +142,11 @@ class Trainer {
   int64_t step_ = 0;
 };
 
-// The trainer for `config.modality` with its branches. Vision needs `images`; audio/joint are
-// not implemented yet (neraf::Error).
+// The trainer for `config.modality` with its branches. Vision/joint need `images`; audio/joint
+// need `rirs` (with features; must outlive the trainer). Modality audio loads the frozen
+// radiance field from config.audio.vision_run (see audio_branch.h).
 std::unique_ptr<Trainer> make_trainer(const TrainConfig& config, const data::ImageSet* images,
-                                      torch::Device device);
+                                      torch::Device device, const data::RirSet* rirs = nullptr);
 
 // Reads a checkpoint's header ("format" and the resolved config) and checks that it describes
 // the same model as `config` (preset, modality, model settings except precision); neraf::Error

@@ -1,0 +1,181 @@
+#include "neraf/train/audio_branch.h"
+
+#include <ATen/CPUGeneratorImpl.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "neraf/acoustic/losses.h"
+#include "neraf/train/audio_run.h"
+#include "neraf/train/checkpoint.h"
+#include "neraf/util/error.h"
+
+namespace neraf::train {
+
+acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, int64_t channels,
+                                                   int64_t n_freq, int64_t max_len) {
+  acoustic::AcousticModelOptions o =
+      acoustic::acoustic_preset(config.preset, channels, n_freq, max_len);
+  const AudioConfig& a = config.audio;
+  o.grid_mode = acoustic::parse_grid_mode(a.grid);
+  o.grid.resolution = a.grid_resolution;
+  o.grid.cells_per_update = a.cells_per_update;
+  if (a.nacf_width > 0) o.nacf.trunk.assign(static_cast<size_t>(a.nacf_layers), a.nacf_width);
+  return o;
+}
+
+std::vector<int64_t> audio_train_subset(const data::RirSet& rirs, double fraction, uint64_t seed) {
+  require(fraction > 0 && fraction <= 1, "--audio-fraction: must be in (0, 1]");
+  std::vector<int64_t> all = rirs.train;
+  if (fraction >= 1.0 || all.empty()) return all;
+  const int64_t n = static_cast<int64_t>(all.size());
+  const int64_t k = std::max<int64_t>(1, std::llround(fraction * static_cast<double>(n)));
+  // Own generator (not the run's stream) so the subset only depends on --seed and the fraction.
+  at::Generator gen = at::make_generator<at::CPUGeneratorImpl>(seed ^ 0x9e3779b97f4a7c15ULL);
+  const torch::Tensor perm = torch::randperm(n, gen, torch::kInt64);
+  std::vector<int64_t> out;
+  for (int64_t i = 0; i < k; ++i) out.push_back(all[static_cast<size_t>(perm[i].item<int64_t>())]);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+AudioBranch::AudioBranch(const TrainConfig& config, const data::RirSet& rirs,
+                         nerf::NerfactoModel field, bool frozen_field, torch::Device device)
+    : config_(config),
+      rirs_(rirs),
+      field_(std::move(field)),
+      frozen_(frozen_field),
+      device_(device) {
+  require(rirs_.has_features(), "dataset: the RIR features were not loaded");
+  require(!rirs_.train.empty(),
+          "dataset: the audio train split is empty; the acoustic field "
+          "needs training RIRs");
+  const acoustic::AcousticModelOptions opts =
+      audio_model_options(config_, rirs_.channels, rirs_.n_freq, rirs_.max_len);
+  model_ = acoustic::AcousticModel(opts);
+  model_->to(device_);
+  grid_ = acoustic::GridSampler(opts.grid);
+  grid_->to(device_);
+  train_rirs_ = audio_train_subset(rirs_, config_.audio.fraction, config_.seed);
+  batch_ = torch::empty({config_.audio.batch_size, rirs_.channels, rirs_.n_freq}, torch::kFloat32);
+  if (frozen_ && opts.grid_mode == acoustic::GridMode::kSampled) {
+    // The paper's separate training: the field is final, so the whole grid is filled once.
+    field_->eval();
+    grid_->refresh_all(field_query());
+  }
+}
+
+acoustic::FieldQueryFn AudioBranch::field_query() {
+  nerf::NerfactoModel field = field_;
+  torch::Device device = device_;
+  return [field, device](const torch::Tensor& u, const torch::Tensor& dirs) mutable {
+    // Appearance of train image 0, as the reference (camera_indices = 0 in training mode).
+    const torch::Tensor app = torch::zeros({1}, torch::dtype(torch::kInt64).device(device));
+    nerf::FieldQuery q = field->field->query(u, dirs, app);
+    return std::make_pair(q.density, q.rgb);
+  };
+}
+
+std::vector<ParamGroup> AudioBranch::param_groups() {
+  std::vector<torch::Tensor> params = model_->parameters();
+  // "Backprop on vision too": the reference's audio optimizer also holds the radiance field.
+  if (!frozen_)
+    for (auto& p : field_->field_parameters()) params.push_back(p);
+  return {{"audio_fields", params, config_.audio.schedule}};
+}
+
+void AudioBranch::set_training(bool training) {
+  model_->train(training);
+  grid_->train(training);
+}
+
+LossDict AudioBranch::losses(StepContext& ctx) {
+  const bool audio_step = ctx.step > config_.audio.start_step;
+  const bool sampled = model_->options().grid_mode == acoustic::GridMode::kSampled;
+  if (sampled && !frozen_) {
+    if (audio_step) {
+      grid_->update(field_query());
+    } else {
+      // No audio loss this step: the same cell values, without building a graph nobody uses.
+      torch::NoGradGuard no_grad;
+      grid_->update(field_query());
+    }
+  }
+  if (!audio_step) return {};
+
+  const int64_t T = rirs_.max_len;
+  const int64_t n = static_cast<int64_t>(train_rirs_.size()) * T;
+  const int64_t B = config_.audio.batch_size;
+  // Shuffled (RIR, frame) slices, epoch-wise without replacement (the reference's DataLoader).
+  std::vector<int64_t> picks;
+  picks.reserve(static_cast<size_t>(B));
+  while (static_cast<int64_t>(picks.size()) < B) {
+    if (!perm_.defined() || cursor_ >= perm_.size(0)) {
+      perm_ = torch::randperm(n, ctx.gen, torch::kInt64);
+      cursor_ = 0;
+    }
+    const int64_t take = std::min(B - static_cast<int64_t>(picks.size()), perm_.size(0) - cursor_);
+    const int64_t* p = perm_.data_ptr<int64_t>() + cursor_;
+    picks.insert(picks.end(), p, p + take);
+    cursor_ += take;
+  }
+  const torch::Tensor slice = torch::tensor(picks, torch::kInt64);
+  const torch::Tensor local = torch::div(slice, T, "floor");
+  const torch::Tensor frame = slice - local * T;
+  const torch::Tensor rir =
+      torch::tensor(train_rirs_, torch::kInt64).index_select(0, local);  // [B]
+  rirs_.gather_into(rir, frame, batch_);
+  const torch::Tensor gt = batch_.to(device_);  // [B, C, F]
+  const torch::Tensor mic =
+      data::normalize_position(rirs_.mic_positions.index_select(0, rir), rirs_.audio_aabb);
+  const torch::Tensor src =
+      data::normalize_position(rirs_.source_positions.index_select(0, rir), rirs_.audio_aabb);
+  const torch::Tensor rot = rirs_.rots.index_select(0, rir);
+  const torch::Tensor pred = model_->forward(grid_->grid(), frame.to(device_), mic.to(device_),
+                                             src.to(device_), rot.to(device_));  // [B, C, F]
+  const acoustic::AudioLossTerms terms = acoustic::sc_slmse_loss(pred, gt);
+  ctx.metrics["audio_sl"] = terms.sl.item<double>();
+  return {{"audio_sc_loss", terms.sc_loss}, {"audio_mag_loss", terms.mag_loss}};
+}
+
+void AudioBranch::save(torch::serialize::OutputArchive& archive) {
+  torch::serialize::OutputArchive m, g;
+  model_->save(m);
+  archive.write("model", m);
+  // The step's backward is done: cut the fresh cells' autograd history so that only values are
+  // serialised (the next update detaches the grid anyway).
+  const_cast<torch::Tensor&>(grid_->grid()).detach_();
+  grid_->save(g);
+  archive.write("grid", g);
+  archive.write("perm", perm_.defined() ? perm_ : torch::empty({0}, torch::kInt64));
+  archive.write("cursor", torch::tensor(cursor_, torch::kInt64));
+  archive.write("manifest", c10::IValue(make_audio_manifest(rirs_).dump()));
+  archive.write("train_rirs", torch::tensor(train_rirs_, torch::kInt64));
+}
+
+void AudioBranch::load(torch::serialize::InputArchive& archive, const std::string& where) {
+  c10::IValue manifest;
+  require(archive.try_read("manifest", manifest) && manifest.isString(),
+          where + ": checkpoint has no audio data manifest; it was not written by neraf train");
+  check_audio_manifest(nlohmann::json::parse(manifest.toStringRef()), rirs_, where);
+  torch::serialize::InputArchive m, g;
+  archive.read("model", m);
+  load_module(*model_, m, where);
+  model_->to(device_);
+  archive.read("grid", g);
+  load_module(*grid_, g, where);
+  grid_->to(device_);
+  torch::Tensor perm, cursor, subset;
+  archive.read("perm", perm);
+  archive.read("cursor", cursor);
+  archive.read("train_rirs", subset);
+  require(subset.numel() == static_cast<int64_t>(train_rirs_.size()) &&
+              std::equal(train_rirs_.begin(), train_rirs_.end(), subset.data_ptr<int64_t>()),
+          where +
+              ": checkpoint was trained on another subset of the RIRs (--audio-fraction or "
+              "--seed differ); use a new --out folder");
+  perm_ = perm.numel() > 0 ? perm : torch::Tensor();
+  cursor_ = cursor.item<int64_t>();
+}
+
+}  // namespace neraf::train

@@ -1,0 +1,282 @@
+#include "neraf/train/audio_eval.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <numeric>
+#include <sstream>
+
+#include "neraf/io/atomic_file.h"
+#include "neraf/train/image_output.h"
+#include "neraf/util/error.h"
+#include "neraf/util/progress.h"
+
+namespace fs = std::filesystem;
+
+namespace neraf::train {
+
+namespace {
+
+double dist3(const geometry::Vec3& a, const geometry::Vec3& b) {
+  const double dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z;
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+io::AudioBuffer to_buffer(const std::vector<std::vector<float>>& ch, int rate) {
+  io::AudioBuffer b;
+  b.sample_rate = rate;
+  b.channels = ch;
+  return b;
+}
+
+io::AudioBuffer tensor_buffer(const torch::Tensor& wave, int rate) {  // [C, L]
+  const torch::Tensor w = wave.to(torch::kFloat32).contiguous();
+  io::AudioBuffer b;
+  b.sample_rate = rate;
+  for (int64_t c = 0; c < w.size(0); ++c) {
+    const float* p = w[c].data_ptr<float>();
+    b.channels.emplace_back(p, p + w.size(1));
+  }
+  return b;
+}
+
+metrics::Variant variant_of(const data::RirSet& rirs) {
+  return rirs.layout == data::AudioLayout::raf ? metrics::Variant::raf
+                                               : metrics::Variant::soundspaces;
+}
+
+std::vector<int64_t> test_indices(const data::RirSet& rirs, int64_t max_rirs) {
+  std::vector<int64_t> t = rirs.test;
+  if (max_rirs >= 0 && static_cast<int64_t>(t.size()) > max_rirs)
+    t.resize(static_cast<size_t>(max_rirs));
+  return t;
+}
+
+// Magma-like colour map: t ∈ [0, 1] → RGB in [0, 1] (piecewise linear through 5 stops).
+void colormap(double t, float* rgb) {
+  static const float stops[5][3] = {{0.0f, 0.0f, 0.02f},
+                                    {0.23f, 0.06f, 0.44f},
+                                    {0.71f, 0.21f, 0.48f},
+                                    {0.98f, 0.53f, 0.38f},
+                                    {0.99f, 0.99f, 0.75f}};
+  t = std::clamp(t, 0.0, 1.0) * 4.0;
+  const int i = std::min(3, static_cast<int>(t));
+  const float f = static_cast<float>(t - i);
+  for (int c = 0; c < 3; ++c) rgb[c] = stops[i][c] * (1 - f) + stops[i + 1][c] * f;
+}
+
+}  // namespace
+
+std::vector<int64_t> nearest_training_rirs(const data::RirSet& rirs,
+                                           const std::vector<int64_t>& train, int64_t query,
+                                           int64_t k, std::vector<double>* dist) {
+  const data::Rir& q = rirs.rirs.at(static_cast<size_t>(query));
+  // Tier 0: same heading and source; tier 1: same heading; tier 2: anything. The first
+  // non-empty tier is used.
+  for (int tier = 0; tier < 3; ++tier) {
+    std::vector<std::pair<double, int64_t>> cand;
+    for (int64_t i : train) {
+      if (i == query) continue;
+      const data::Rir& r = rirs.rirs.at(static_cast<size_t>(i));
+      const bool same_heading = r.heading_deg == q.heading_deg;
+      const double ds = dist3(r.source, q.source);
+      const bool same_source = ds < 1e-3;
+      if (tier == 0 && !(same_heading && same_source)) continue;
+      if (tier == 1 && !same_heading) continue;
+      const double d = dist3(r.mic, q.mic) + (tier == 0 ? 0.0 : ds);
+      cand.emplace_back(d, i);
+    }
+    if (cand.empty()) continue;
+    std::stable_sort(cand.begin(), cand.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    if (k > 0 && static_cast<int64_t>(cand.size()) > k) cand.resize(static_cast<size_t>(k));
+    std::vector<int64_t> out;
+    if (dist) dist->clear();
+    for (const auto& [d, i] : cand) {
+      out.push_back(i);
+      if (dist) dist->push_back(d);
+    }
+    return out;
+  }
+  if (dist) dist->clear();
+  return {};
+}
+
+AudioMethodEval evaluate_audio_model(const AudioRun& run, const data::RirSet& rirs,
+                                     const std::vector<int64_t>& test, const std::string& label,
+                                     const AudioEvalOptions& options) {
+  AudioMethodEval m;
+  m.name = label;
+  const metrics::Variant variant = variant_of(rirs);
+  Progress progress("eval audio (" + label + ")", static_cast<int64_t>(test.size()),
+                    ProgressOptions{"RIR", 0.2, 10.0, options.progress});
+  for (size_t n = 0; n < test.size(); ++n) {
+    const int64_t i = test[n];
+    const data::Rir& r = rirs.rirs[static_cast<size_t>(i)];
+    const torch::Tensor pred = run.predict_log_stft(r.mic, r.source, r.heading_deg);  // [C, F, T]
+    const auto wave = griffin_lim_channels(log_stft_to_magnitude(pred), rirs.stft,
+                                           options.seed + static_cast<uint64_t>(n));
+    const io::AudioBuffer gt = tensor_buffer(rirs.waveform(i), rirs.sample_rate);
+    m.per_rir.push_back(metrics::compare_rirs(to_buffer(wave, rirs.sample_rate), gt, variant,
+                                              label + " " + r.id, r.id));
+    if (!options.out_dir.empty() && static_cast<int64_t>(n) < options.num_images &&
+        label == "neraf") {
+      char name[64];
+      std::snprintf(name, sizeof name, "audio_%05zu.png", n);
+      write_stft_comparison_png((fs::path(options.out_dir) / name).string(), pred,
+                                rirs.features(i));
+    }
+    progress.update(static_cast<int64_t>(n) + 1);
+  }
+  progress.finish();
+  m.summary = metrics::summarize(m.per_rir);
+  return m;
+}
+
+AudioEval evaluate_audio(const AudioRun& run, const data::RirSet& rirs,
+                         const std::vector<int64_t>& train_subset,
+                         const AudioEvalOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  require(!rirs.test.empty(), rirs.root + ": the audio test split is empty; nothing to evaluate");
+  AudioEval e;
+  const std::vector<int64_t> test = test_indices(rirs, options.max_rirs);
+  for (int64_t i : test) e.rir_ids.push_back(rirs.rirs[static_cast<size_t>(i)].id);
+  if (!options.out_dir.empty()) fs::create_directories(options.out_dir);
+  e.methods.push_back(evaluate_audio_model(run, rirs, test, "neraf", options));
+
+  if (options.baselines) {
+    require(!train_subset.empty(), "baselines: no training RIRs");
+    const metrics::Variant variant = variant_of(rirs);
+    AudioMethodEval nearest{"nearest", {}, {}}, linear{"linear", {}, {}};
+    Progress progress("eval audio (baselines)", static_cast<int64_t>(test.size()),
+                      ProgressOptions{"RIR", 0.2, 10.0, options.progress});
+    for (size_t n = 0; n < test.size(); ++n) {
+      const int64_t i = test[n];
+      const io::AudioBuffer gt = tensor_buffer(rirs.waveform(i), rirs.sample_rate);
+      std::vector<double> d;
+      const std::vector<int64_t> nb = nearest_training_rirs(rirs, train_subset, i, 4, &d);
+      // nearest: the neighbour's measured waveform.
+      nearest.per_rir.push_back(
+          metrics::compare_rirs(tensor_buffer(rirs.waveform(nb[0]), rirs.sample_rate), gt, variant,
+                                "nearest " + rirs.rirs[static_cast<size_t>(nb[0])].id,
+                                rirs.rirs[static_cast<size_t>(i)].id));
+      // linear: inverse-distance-weighted magnitude blend, then Griffin-Lim.
+      std::vector<double> w(nb.size());
+      if (d[0] < 1e-6) {
+        std::fill(w.begin(), w.end(), 0.0);
+        w[0] = 1.0;
+      } else {
+        for (size_t j = 0; j < nb.size(); ++j) w[j] = 1.0 / (d[j] + 1e-3);
+      }
+      const double wsum = std::accumulate(w.begin(), w.end(), 0.0);
+      torch::Tensor mag;
+      for (size_t j = 0; j < nb.size(); ++j) {
+        const torch::Tensor mj = log_stft_to_magnitude(rirs.features(nb[j])) * (w[j] / wsum);
+        mag = mag.defined() ? mag + mj : mj;
+      }
+      const auto wave = griffin_lim_channels(mag, rirs.stft, options.seed + n);
+      linear.per_rir.push_back(metrics::compare_rirs(to_buffer(wave, rirs.sample_rate), gt, variant,
+                                                     "linear",
+                                                     rirs.rirs[static_cast<size_t>(i)].id));
+      progress.update(static_cast<int64_t>(n) + 1);
+    }
+    progress.finish();
+    nearest.summary = metrics::summarize(nearest.per_rir);
+    linear.summary = metrics::summarize(linear.per_rir);
+    e.methods.push_back(std::move(nearest));
+    e.methods.push_back(std::move(linear));
+  }
+  e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return e;
+}
+
+nlohmann::json to_json(const metrics::RirErrorSummary& s) {
+  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+  nlohmann::json j;
+  j["n_rirs"] = s.count;
+  const std::pair<const char*, const metrics::MetricStats*> keys[] = {
+      {"t60_error_pct", &s.t60_error_pct},
+      {"c50_error_db", &s.c50_error_db},
+      {"edt_error_s", &s.edt_error_s},
+      {"stft_error", &s.stft_error},
+      {"invalid_t60", &s.invalid_t60}};
+  for (const auto& [k, m] : keys) {
+    j[k] = num(m->mean);
+    j[std::string(k) + "_std"] = num(m->std);
+    if (m->non_finite > 0) j[std::string(k) + "_non_finite"] = m->non_finite;
+  }
+  return j;
+}
+
+nlohmann::json to_json(const AudioEval& e) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& m : e.methods) j[m.name] = to_json(m.summary);
+  return j;
+}
+
+void write_audio_csv(const std::string& path, const AudioEval& e) {
+  std::ostringstream out;
+  out << "rir_id,method,t60_error_pct,c50_error_db,edt_error_s,stft_error,invalid_t60\n";
+  char buf[256];
+  for (const auto& m : e.methods)
+    for (size_t n = 0; n < m.per_rir.size() && n < e.rir_ids.size(); ++n) {
+      const auto& r = m.per_rir[n];
+      std::snprintf(buf, sizeof buf, ",%s,%.6g,%.6g,%.6g,%.6g,%d\n", m.name.c_str(),
+                    r.t60_error_pct, r.c50_error_db, r.edt_error_s, r.stft_error,
+                    r.invalid_t60 ? 1 : 0);
+      out << e.rir_ids[n] << buf;
+    }
+  io::write_text_atomically(path, out.str());
+}
+
+std::string audio_table(const std::vector<AudioMethodEval>& methods) {
+  std::ostringstream out;
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "%-22s %10s %10s %10s %10s %9s %6s\n", "method", "T60 (%)",
+                "C50 (dB)", "EDT (s)", "STFT err", "invalid", "n");
+  out << buf;
+  for (const auto& m : methods) {
+    const auto& s = m.summary;
+    std::snprintf(buf, sizeof buf, "%-22s %10.3f %10.4f %10.5f %10.4f %9.3f %6zu\n", m.name.c_str(),
+                  s.t60_error_pct.mean, s.c50_error_db.mean, s.edt_error_s.mean, s.stft_error.mean,
+                  s.invalid_t60.mean, s.count);
+    out << buf;
+  }
+  return out.str();
+}
+
+void write_stft_comparison_png(const std::string& path, const torch::Tensor& pred,
+                               const torch::Tensor& gt) {
+  TORCH_CHECK(pred.dim() == 3 && gt.dim() == 3, "write_stft_comparison_png: expected [C, F, T]");
+  const torch::Tensor p =
+      pred[0].to(torch::kFloat32).flip({0}).contiguous();  // [F, T], low at bottom
+  const torch::Tensor g = gt[0].to(torch::kFloat32).flip({0}).contiguous();
+  const double lo = std::min(p.min().item<double>(), g.min().item<double>());
+  const double hi = std::max(p.max().item<double>(), g.max().item<double>());
+  const int64_t F = p.size(0), T = p.size(1), Tg = g.size(1), gap = 2, s = 3;
+  const int64_t W = (T + gap + Tg) * s, H = F * s;
+  torch::Tensor img = torch::ones({H, W, 3}, torch::kFloat32);
+  float* out = img.data_ptr<float>();
+  auto paint = [&](const torch::Tensor& m, int64_t x0) {
+    const float* v = m.data_ptr<float>();
+    for (int64_t f = 0; f < m.size(0); ++f)
+      for (int64_t t = 0; t < m.size(1); ++t) {
+        float rgb[3];
+        colormap((v[f * m.size(1) + t] - lo) / std::max(hi - lo, 1e-9), rgb);
+        for (int64_t dy = 0; dy < s; ++dy)
+          for (int64_t dx = 0; dx < s; ++dx) {
+            float* px = out + ((f * s + dy) * W + (x0 + t) * s + dx) * 3;
+            px[0] = rgb[0];
+            px[1] = rgb[1];
+            px[2] = rgb[2];
+          }
+      }
+  };
+  paint(p, 0);
+  paint(g, T + gap);
+  write_png(path, img);
+}
+
+}  // namespace neraf::train

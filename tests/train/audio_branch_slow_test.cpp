@@ -1,0 +1,30 @@
+// Slow: a few dozen joint steps on the tiny SoundSpaces fixture reduce the audio loss.
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include <numeric>
+
+#include "audio_test_util.h"
+#include "neraf/train/audio_branch.h"
+#include "neraf/train/trainer.h"
+
+namespace neraf::train {
+namespace {
+
+TEST(AudioBranchSlow, JointTrainingReducesTheAudioLoss) {
+  torch::manual_seed(0);
+  const std::string dir = testing::make_temp_dir("slow");
+  const data::RirSet rirs = testing::tiny_rir_set(dir);
+  const data::ImageSet images = testing::make_image_set();
+  TrainConfig c = testing::tiny_joint_config();
+  c.steps = 60;
+  auto trainer = make_trainer(c, &images, torch::kCPU, &rirs);
+  std::vector<double> mag;
+  for (int i = 0; i < 60; ++i) mag.push_back(trainer->step().losses.at("audio_mag_loss"));
+  const double first = std::accumulate(mag.begin(), mag.begin() + 5, 0.0) / 5;
+  const double last = std::accumulate(mag.end() - 5, mag.end(), 0.0) / 5;
+  EXPECT_LT(last, 0.5 * first) << "first " << first << " last " << last;
+}
+
+}  // namespace
+}  // namespace neraf::train

@@ -1,0 +1,231 @@
+// The acoustic branch in the trainer: checkpoint round trip, dataset/preset mismatch errors,
+// few-shot subsets, baseline neighbour selection, and the eval JSON/CSV/PNG outputs.
+#include "neraf/train/audio_branch.h"
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "audio_test_util.h"
+#include "neraf/io/json_file.h"
+#include "neraf/train/audio_eval.h"
+#include "neraf/train/audio_run.h"
+#include "neraf/train/checkpoint.h"
+#include "neraf/train/trainer.h"
+#include "neraf/util/error.h"
+
+namespace neraf::train {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::make_image_set;
+using testing::make_temp_dir;
+using testing::tiny_joint_config;
+using testing::tiny_rir_set;
+
+TEST(AudioBranch, JointStepReportsAudioLossesAndTouchesTheGrid) {
+  torch::manual_seed(0);
+  const std::string dir = make_temp_dir("step");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  const data::ImageSet images = make_image_set();
+  auto trainer = make_trainer(tiny_joint_config(), &images, torch::kCPU, &rirs);
+  auto* audio = dynamic_cast<AudioBranch*>(trainer->branch("audio"));
+  ASSERT_NE(audio, nullptr);
+  EXPECT_EQ(audio->grid()->pointer(), 0);
+  const StepResult r = trainer->step();
+  EXPECT_TRUE(r.losses.count("audio_sc_loss"));
+  EXPECT_TRUE(r.losses.count("audio_mag_loss"));
+  EXPECT_TRUE(r.losses.count("rgb_loss"));
+  EXPECT_GT(r.losses.at("audio_mag_loss"), 0.0);
+  EXPECT_EQ(audio->grid()->pointer(), 512);
+  // Written cells hold the field's values (alpha in [0,1], rgb in (0,1)); others stay zero.
+  const torch::Tensor g = audio->grid()->grid().detach().reshape({7, -1});
+  EXPECT_GT(
+      g.index({torch::indexing::Slice(0, 3), torch::indexing::Slice(0, 512)}).min().item<double>(),
+      0.0);
+  EXPECT_EQ(
+      g.index({torch::indexing::Slice(0, 4), torch::indexing::Slice(512, torch::indexing::None)})
+          .abs()
+          .max()
+          .item<double>(),
+      0.0);
+  EXPECT_GT(trainer->group_lr("audio_fields"), 0.0);
+}
+
+TEST(AudioBranch, BeforeStartStepOnlyTheGridMoves) {
+  torch::manual_seed(0);
+  const std::string dir = make_temp_dir("start");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  const data::ImageSet images = make_image_set();
+  TrainConfig c = tiny_joint_config();
+  c.audio.start_step = 1;  // audio on steps 2, 3, ... (0-based index > 1)
+  auto trainer = make_trainer(c, &images, torch::kCPU, &rirs);
+  auto* audio = dynamic_cast<AudioBranch*>(trainer->branch("audio"));
+  EXPECT_FALSE(trainer->step().losses.count("audio_mag_loss"));
+  EXPECT_FALSE(trainer->step().losses.count("audio_mag_loss"));
+  EXPECT_EQ(audio->grid()->pointer(), 1024);
+  EXPECT_TRUE(trainer->step().losses.count("audio_mag_loss"));
+}
+
+TEST(AudioBranch, CheckpointRoundTripResumesExactly) {
+  torch::manual_seed(0);
+  const std::string dir = make_temp_dir("ckpt");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  const data::ImageSet images = make_image_set();
+  const TrainConfig c = tiny_joint_config();
+  auto a = make_trainer(c, &images, torch::kCPU, &rirs);
+  for (int i = 0; i < 3; ++i) a->step();
+  const std::string path = dir + "/step3.pt";
+  a->save_checkpoint(path);
+  torch::manual_seed(123);  // different init: everything must come from the checkpoint
+  auto b = make_trainer(c, &images, torch::kCPU, &rirs);
+  b->load_checkpoint(path);
+  auto* aa = dynamic_cast<AudioBranch*>(a->branch("audio"));
+  auto* bb = dynamic_cast<AudioBranch*>(b->branch("audio"));
+  EXPECT_EQ(bb->grid()->pointer(), aa->grid()->pointer());
+  EXPECT_TRUE(torch::equal(bb->grid()->grid().detach(), aa->grid()->grid().detach()));
+  const StepResult ra = a->step(), rb = b->step();
+  EXPECT_EQ(rb.step, 4);
+  EXPECT_DOUBLE_EQ(ra.losses.at("audio_mag_loss"), rb.losses.at("audio_mag_loss"));
+  EXPECT_DOUBLE_EQ(ra.losses.at("audio_sc_loss"), rb.losses.at("audio_sc_loss"));
+  EXPECT_DOUBLE_EQ(ra.losses.at("rgb_loss"), rb.losses.at("rgb_loss"));
+}
+
+TEST(AudioBranch, MismatchedDatasetOrPresetIsAClearError) {
+  torch::manual_seed(0);
+  const std::string dir = make_temp_dir("mismatch");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  const data::RirSet moved = tiny_rir_set(dir + "/other", /*move_a_point=*/true);
+  const data::ImageSet images = make_image_set();
+  const TrainConfig c = tiny_joint_config();
+  auto a = make_trainer(c, &images, torch::kCPU, &rirs);
+  a->step();
+  const std::string path = dir + "/step1.pt";
+  a->save_checkpoint(path);
+  auto b = make_trainer(c, &images, torch::kCPU, &moved);
+  try {
+    b->load_checkpoint(path);
+    FAIL() << "expected neraf::Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("another RIR dataset"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("hash"), std::string::npos) << e.what();
+  }
+  // Another preset (or grid mode) is refused by the header check.
+  torch::serialize::InputArchive arch;
+  load_archive(arch, path);
+  TrainConfig other = c;
+  other.audio.grid = "none";
+  EXPECT_THROW(check_checkpoint_header(arch, other, path), Error);
+  TrainConfig paper = c;
+  paper.preset = "paper";
+  EXPECT_THROW(check_checkpoint_header(arch, paper, path), Error);
+}
+
+TEST(AudioBranch, FewShotSubsetIsSeededAndSized) {
+  const std::string dir = make_temp_dir("subset");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  ASSERT_EQ(rirs.train.size(), 5u);
+  EXPECT_EQ(audio_train_subset(rirs, 1.0, 1), rirs.train);
+  const auto s = audio_train_subset(rirs, 0.4, 7);
+  EXPECT_EQ(s.size(), 2u);
+  EXPECT_EQ(s, audio_train_subset(rirs, 0.4, 7));
+  EXPECT_TRUE(std::is_sorted(s.begin(), s.end()));
+  for (int64_t i : s)
+    EXPECT_NE(std::find(rirs.train.begin(), rirs.train.end(), i), rirs.train.end());
+  EXPECT_EQ(audio_train_subset(rirs, 0.01, 7).size(), 1u);
+  EXPECT_THROW(audio_train_subset(rirs, 0.0, 7), Error);
+}
+
+data::Rir hand_rir(double mx, double my, double mz, double sx, int heading) {
+  data::Rir r;
+  r.mic = {mx, my, mz};
+  r.source = {sx, 1.0, 0.0};
+  r.heading_deg = heading;
+  return r;
+}
+
+TEST(AudioBaselines, NearestPicksSameHeadingAndSourceClosestMic) {
+  data::RirSet set;
+  set.rirs = {
+      hand_rir(0.0, 1.0, 0.0, 5.0, 90),  // 0 query (test)
+      hand_rir(0.1, 1.0, 0.0, 5.0, 0),   // 1 closest mic but other heading
+      hand_rir(0.2, 1.0, 0.0, 4.0, 90),  // 2 close mic, other source
+      hand_rir(1.0, 1.0, 0.0, 5.0, 90),  // 3 same heading + source, far
+      hand_rir(0.0, 1.0, 0.6, 5.0, 90),  // 4 same heading + source, nearest of those (0.6)
+      hand_rir(0.0, 1.7, 0.0, 5.0, 90),  // 5 same heading + source (0.7)
+  };
+  const std::vector<int64_t> train = {1, 2, 3, 4, 5};
+  std::vector<double> d;
+  const auto nb = nearest_training_rirs(set, train, 0, 4, &d);
+  ASSERT_EQ(nb.size(), 3u);  // only 3, 4, 5 qualify
+  EXPECT_EQ(nb[0], 4);
+  EXPECT_EQ(nb[1], 5);
+  EXPECT_EQ(nb[2], 3);
+  EXPECT_NEAR(d[0], 0.6, 1e-12);
+  EXPECT_NEAR(d[2], 1.0, 1e-12);
+  // Without any same-source candidate: same heading (mic + source distance) wins over others.
+  const auto nb2 = nearest_training_rirs(set, {1, 2}, 0, 1, &d);
+  ASSERT_EQ(nb2.size(), 1u);
+  EXPECT_EQ(nb2[0], 2);
+  EXPECT_NEAR(d[0], 0.2 + 1.0, 1e-12);
+  // No same heading at all: the closest pose overall.
+  EXPECT_EQ(nearest_training_rirs(set, {1}, 0, 1)[0], 1);
+}
+
+TEST(AudioEval, RunFolderPredictsAndWritesJsonCsvPng) {
+  torch::manual_seed(0);
+  const std::string dir = make_temp_dir("eval");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  const data::ImageSet images = make_image_set();
+  const TrainConfig c = tiny_joint_config();
+  auto trainer = make_trainer(c, &images, torch::kCPU, &rirs);
+  trainer->step();
+  trainer->step();
+  const std::string run = dir + "/run";
+  trainer->save_checkpoint(checkpoint_path(run, 2));
+  io::write_json_atomically(run + "/config.json", to_json(c));
+  io::write_json_atomically(run + "/data.json", {{"audio", make_audio_manifest(rirs)}});
+
+  const AudioRun ar = load_audio_run(run);
+  EXPECT_EQ(ar.step(), 2);
+  EXPECT_EQ(ar.info().channels, 2);
+  EXPECT_EQ(ar.info().sample_rate, 22050);
+  const torch::Tensor p = ar.predict_log_stft(rirs.rirs[5].mic, rirs.rirs[5].source, 90.0);
+  EXPECT_EQ(p.sizes(), (std::vector<int64_t>{2, 257, rirs.max_len}));
+  EXPECT_TRUE(torch::isfinite(p).all().item<bool>());
+  const auto wave = ar.predict_waveform(rirs.rirs[5].mic, rirs.rirs[5].source, 90.0, 0, 1000);
+  ASSERT_EQ(wave.size(), 2u);
+  EXPECT_EQ(wave[0].size(), 1000u);
+
+  AudioEvalOptions o;
+  o.out_dir = dir + "/eval";
+  o.num_images = 1;
+  o.progress = false;
+  const AudioEval e = evaluate_audio(ar, rirs, rirs.train, o);
+  ASSERT_EQ(e.methods.size(), 3u);
+  const nlohmann::json j = to_json(e);
+  for (const char* m : {"neraf", "nearest", "linear"})
+    for (const char* k :
+         {"t60_error_pct", "c50_error_db", "edt_error_s", "stft_error", "invalid_t60", "n_rirs"})
+      EXPECT_TRUE(j.at(m).contains(k)) << m << "." << k;
+  EXPECT_EQ(j["neraf"]["n_rirs"], 2);
+  write_audio_csv(o.out_dir + "/audio_per_rir.csv", e);
+  std::ifstream csv(o.out_dir + "/audio_per_rir.csv");
+  int lines = 0;
+  for (std::string l; std::getline(csv, l);) ++lines;
+  EXPECT_EQ(lines, 1 + 3 * 2);
+  EXPECT_TRUE(fs::exists(o.out_dir + "/audio_00000.png"));
+  EXPECT_NE(audio_table(e.methods).find("nearest"), std::string::npos);
+}
+
+TEST(AudioRun, VisionRunHasNoAcousticField) {
+  const std::string dir = make_temp_dir("visiononly");
+  TrainConfig c = testing::tiny_train_config();
+  io::write_json_atomically(dir + "/config.json", to_json(c));
+  EXPECT_THROW(load_audio_run(dir), Error);
+}
+
+}  // namespace
+}  // namespace neraf::train
