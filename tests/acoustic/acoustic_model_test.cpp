@@ -28,6 +28,7 @@ Batch random_batch(int64_t b, int64_t max_len) {
 TEST(AcousticModel, PresetsResolveSizes) {
   const auto cpu = acoustic_preset("cpu", 2, 257, 78);
   EXPECT_EQ(cpu.grid.resolution, 32);
+  EXPECT_EQ(cpu.grid.cells_per_update, 1024);
   EXPECT_EQ(cpu.nacf.in_features(), 256 + 163);
   EXPECT_TRUE(cpu.nacf.bf16);
   const auto paper = acoustic_preset("paper", 1, 513, 60);

@@ -36,7 +36,10 @@ AcousticModelOptions acoustic_preset(const std::string& name, int64_t n_channels
     o.nacf = nacf_paper_options(n_channels, n_freq, resnet3d_out_features(o.resnet));
   } else if (name == "cpu") {
     o.grid.resolution = 32;
-    o.grid.cells_per_update = 4096;
+    // 1024 cells × 18 directions = 18,432 radiance-field queries with autograd per step (the
+    // paper's 4096 would add ~74k field samples, more than the vision batch itself on 2 cores);
+    // a full sweep of the 32³ grid still takes only 32 steps (paper: 512 steps for 128³).
+    o.grid.cells_per_update = 1024;
     o.resnet = resnet3d_cpu_options();
     o.nacf = nacf_cpu_options(n_channels, n_freq, resnet3d_out_features(o.resnet));
     o.nacf.bf16 = true;

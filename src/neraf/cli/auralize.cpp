@@ -9,6 +9,7 @@
 #include <string>
 
 #include "neraf/cli/commands.h"
+#include "neraf/cli/render_audio.h"
 #include "neraf/dsp/resample.h"
 #include "neraf/io/audio_file.h"
 #include "neraf/util/error.h"
@@ -19,6 +20,8 @@ namespace {
 
 struct AuralizeArgs {
   std::string rir_path;
+  std::string run_dir;  // model mode: render the RIR from a trained run instead of --rir
+  AudioPoseArgs pose;
   std::string dry_path;
   std::string out_path;
   bool normalize = false;
@@ -83,10 +86,22 @@ void register_auralize(CLI::App& app) {
       "with a stereo RIR is convolved channel by channel; with a mono RIR every dry channel is\n"
       "convolved. Dry audio at another sample rate is resampled to the RIR's rate. The output\n"
       "has len(dry) + len(rir) - 1 samples and is written as a 32-bit float WAV (.flac: 24-bit\n"
-      "FLAC).");
-  cmd->add_option("--rir", args->rir_path,
-                  "Room impulse response to convolve with (required): WAV/FLAC, mono or "
-                  "multichannel, e.g. a measured RIR or one rendered by 'neraf render'");
+      "FLAC).\n"
+      "Give the impulse response as a file (--rir) or as a pose in a trained run (--run with\n"
+      "--mic, --src and the orientation): the RIR is then rendered exactly as 'neraf render rir'.");
+  cmd->footer("With --run:\n" + audio_pose_help() +
+              "Example: neraf auralize --run runs/demo --mic 2.0,1.5,1.6 --src 1.1,1.2,0.9 "
+              "--yaw 90 --in speech.wav --out speech_in_room.wav --normalize");
+  CLI::Option* rir_opt = cmd->add_option(
+      "--rir", args->rir_path,
+      "Room impulse response to convolve with: WAV/FLAC, mono or multichannel, e.g. a measured "
+      "RIR or one rendered by 'neraf render rir' (this or --run)");
+  CLI::Option* run_opt = cmd->add_option(
+      "--run", args->run_dir,
+      "Trained run (joint or audio) whose acoustic field gives the RIR at --mic/--src (this or "
+      "--rir)");
+  rir_opt->excludes(run_opt);
+  const auto pose_opts = add_audio_pose_options(cmd, args->pose, true, false, run_opt);
   cmd->add_option(
          "--in", args->dry_path,
          "Dry audio to place in the room (WAV/FLAC, mono, stereo, or as many channels as the RIR)")
@@ -95,10 +110,21 @@ void register_auralize(CLI::App& app) {
   cmd->add_flag("--normalize", args->normalize,
                 "Scale the result so its peak is 0.99 (same gain on all channels). Without it the "
                 "level is kept and a warning is printed if the result would clip");
-  cmd->callback([args] {
-    // Checked here rather than with ->required() so that another source of impulse responses (a
-    // trained model) can be added as an alternative option; still a usage error (exit 2).
-    if (args->rir_path.empty()) throw CLI::RequiredError("--rir");
+  cmd->callback([args, rir_opt, run_opt, pose_opts] {
+    // Checked here rather than with ->required(): --rir and --run are alternatives; still usage
+    // errors (exit 2).
+    if (rir_opt->count() == 0 && run_opt->count() == 0) {
+      throw CLI::RequiredError("--rir or --run");
+    }
+    if (run_opt->count() > 0) {
+      if (pose_opts.first->count() == 0) throw CLI::RequiredError("--mic (with --run)");
+      if (pose_opts.second->count() == 0) throw CLI::RequiredError("--src (with --run)");
+      std::string summary;
+      const io::AudioBuffer rir = render_rir_from_run(args->run_dir, args->pose, &summary);
+      info("rendered the RIR: " + summary);
+      auralize_and_write(rir, "rendered from " + args->run_dir, args->dry_path, *args);
+      return;
+    }
     const io::AudioBuffer rir = io::read_audio(args->rir_path);
     auralize_and_write(rir, args->rir_path, args->dry_path, *args);
   });

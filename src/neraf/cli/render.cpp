@@ -9,6 +9,7 @@
 #include <string>
 
 #include "neraf/cli/commands.h"
+#include "neraf/cli/render_audio.h"
 #include "neraf/render/view.h"
 #include "neraf/train/run.h"
 #include "neraf/util/error.h"
@@ -76,10 +77,11 @@ void add_render_view(CLI::App& render) {
 }  // namespace
 
 void register_render(CLI::App& app) {
-  CLI::App* render = app.add_subcommand("render", "Render views (and, later, sounds) of a run");
+  CLI::App* render = app.add_subcommand(
+      "render", "Render views, impulse responses (WAV) and loudness maps of a trained run");
   render->require_subcommand(1);
   add_render_view(*render);
-  // The acoustic branch: add_render_rir(*render); ...
+  add_render_audio_commands(*render);  // rir, loudness (render_audio.cpp)
 }
 
 }  // namespace neraf::cli

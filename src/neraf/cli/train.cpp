@@ -102,7 +102,7 @@ void register_train(CLI::App& app) {
       "the grid (frozen)");
   CLI::Option* audio_start = cmd->add_option(
       "--audio-start-step", args->audio_start,
-      "Audio losses start after this step (default: the preset's; cpu 1500, paper 2000; audio "
+      "Audio losses start after this step (default: the preset's; cpu 1000, paper 2000; audio "
       "modality 0)");
   cmd->add_option("--out", args->out, "Run folder to create (or to resume)")->required();
   cmd->add_flag("--resume", args->resume,

@@ -34,14 +34,12 @@ struct Glyph {
   unsigned char rows[5];
 };
 constexpr Glyph kFont[] = {
-    {'0', {7, 5, 5, 5, 7}}, {'1', {2, 6, 2, 2, 7}}, {'2', {7, 1, 7, 4, 7}},
-    {'3', {7, 1, 7, 1, 7}}, {'4', {5, 5, 7, 1, 1}}, {'5', {7, 4, 7, 1, 7}},
-    {'6', {7, 4, 7, 5, 7}}, {'7', {7, 1, 1, 1, 1}}, {'8', {7, 5, 7, 5, 7}},
-    {'9', {7, 5, 7, 1, 7}}, {'.', {0, 0, 0, 0, 2}}, {'-', {0, 0, 7, 0, 0}},
-    {'+', {0, 2, 7, 2, 0}}, {'x', {0, 5, 2, 5, 0}}, {'y', {5, 5, 2, 2, 2}},
-    {'z', {0, 7, 2, 4, 7}}, {'m', {0, 7, 7, 5, 5}}, {'d', {1, 1, 7, 5, 7}},
-    {'B', {6, 5, 6, 5, 6}}, {'l', {2, 2, 2, 2, 2}}, {'o', {0, 7, 5, 5, 7}},
-    {'g', {7, 5, 7, 1, 6}}, {'(', {1, 2, 2, 2, 1}}, {')', {4, 2, 2, 2, 4}},
+    {'0', {7, 5, 5, 5, 7}}, {'1', {2, 6, 2, 2, 7}}, {'2', {7, 1, 7, 4, 7}}, {'3', {7, 1, 7, 1, 7}},
+    {'4', {5, 5, 7, 1, 1}}, {'5', {7, 4, 7, 1, 7}}, {'6', {7, 4, 7, 5, 7}}, {'7', {7, 1, 1, 1, 1}},
+    {'8', {7, 5, 7, 5, 7}}, {'9', {7, 5, 7, 1, 7}}, {'.', {0, 0, 0, 0, 2}}, {'-', {0, 0, 7, 0, 0}},
+    {'+', {0, 2, 7, 2, 0}}, {'x', {0, 5, 2, 5, 0}}, {'y', {5, 5, 2, 2, 2}}, {'z', {0, 7, 2, 4, 7}},
+    {'m', {0, 7, 7, 5, 5}}, {'d', {1, 1, 7, 5, 7}}, {'B', {6, 5, 6, 5, 6}}, {'l', {2, 2, 2, 2, 2}},
+    {'o', {0, 7, 5, 5, 7}}, {'g', {7, 5, 7, 1, 6}}, {'(', {1, 2, 2, 2, 1}}, {')', {4, 2, 2, 2, 4}},
     {'s', {0, 7, 4, 1, 7}}, {'r', {0, 7, 4, 4, 4}}, {'c', {0, 7, 4, 4, 7}},
 };
 
@@ -99,8 +97,10 @@ void Canvas::text(const std::string& s, int x, int y, int scale, float r, float 
 
 void Canvas::ring(double cx, double cy, double radius, double thickness, float r, float g,
                   float b) {
-  const int x0 = int(std::floor(cx - radius - thickness)), x1 = int(std::ceil(cx + radius + thickness));
-  const int y0 = int(std::floor(cy - radius - thickness)), y1 = int(std::ceil(cy + radius + thickness));
+  const int x0 = int(std::floor(cx - radius - thickness)),
+            x1 = int(std::ceil(cx + radius + thickness));
+  const int y0 = int(std::floor(cy - radius - thickness)),
+            y1 = int(std::ceil(cy + radius + thickness));
   for (int y = y0; y <= y1; ++y) {
     for (int x = x0; x <= x1; ++x) {
       const double d = std::hypot(x + 0.5 - cx, y + 0.5 - cy);

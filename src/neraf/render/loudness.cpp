@@ -50,8 +50,9 @@ FloorGrid make_floor_grid(const data::Aabb& aabb, const FloorGridOptions& option
   FloorGrid g;
   g.height = std::isnan(options.height_m) ? 0.5 * (aabb.min.y + aabb.max.y) : options.height_m;
   require(std::isfinite(g.height) && g.height > aabb.min.y && g.height < aabb.max.y,
-          "--height: " + std::to_string(g.height) + " m is outside the run's audio bounding box (y " +
-              std::to_string(aabb.min.y) + " .. " + std::to_string(aabb.max.y) +
+          "--height: " + std::to_string(g.height) +
+              " m is outside the run's audio bounding box (y " + std::to_string(aabb.min.y) +
+              " .. " + std::to_string(aabb.max.y) +
               "); predictions there are meaningless; choose a height inside it");
   double spacing = options.spacing_m;
   const double w = std::max(x1 - x0, 0.0), d = std::max(z1 - z0, 0.0);
@@ -79,7 +80,6 @@ torch::Tensor spectrogram_rms(const torch::Tensor& magnitude) {
 
 torch::Tensor log_loudness(const torch::Tensor& log_stft) {
   TORCH_CHECK(log_stft.dim() == 4, "log_loudness: expected [N, C, F, T]");
-  using torch::indexing::Slice;
   const torch::Tensor mag = log_stft_to_magnitude(log_stft.select(1, 0)).to(torch::kFloat64);
   return spectrogram_rms(mag).sum(-1).log();  // [N]
 }
@@ -139,7 +139,7 @@ void write_loudness_png(const std::string& path, const LoudnessMap& map) {
 
   const int cell = std::max(2, 480 / std::max(nx, nz));
   const int s = 2;  // font scale
-  const int left = 16 * s + 10, top = 12, bottom = 24 * s / 2 + 16;
+  const int left = 16 * s + 10, top = 8 + 7 * s, bottom = 24 * s / 2 + 16;
   const int map_w = nx * cell, map_h = nz * cell;
   const int bar_gap = 14, bar_w = 16;
   const std::string hi_s = fmt(hi, 2), lo_s = fmt(lo, 2);
@@ -181,7 +181,7 @@ void write_loudness_png(const std::string& path, const LoudnessMap& map) {
   }
   c.text("x (m)", left + map_w - Canvas::text_width("x (m)", s), top + map_h + 7 + 7 * s, s, 0, 0,
          0);
-  c.text("z", 2, top, s, 0, 0, 0);
+  c.text("z (m)", 2, 4, s, 0, 0, 0);
 
   // Source marker.
   const double sx = px(map.source.x), sz = pz(map.source.z);

@@ -20,7 +20,7 @@ struct FloorGridOptions {
   double spacing_m = 0.1;  // reference: 0.1 m
   double margin_m = 0.5;   // beyond the train mics' bounding box (reference: 0.5 m)
   double height_m = std::numeric_limits<double>::quiet_NaN();  // mic height (y); NaN = the
-                                                              // middle of the train mics' heights
+                                                               // middle of the train mics' heights
   int64_t max_points = 4000;  // coarser spacing when the grid would have more points than this
 };
 
@@ -29,7 +29,7 @@ struct FloorGrid {
   std::vector<double> x;  // [nx] ascending
   std::vector<double> z;  // [nz] ascending
   double height = 0;
-  double spacing = 0;     // actually used (≥ options.spacing_m)
+  double spacing = 0;  // actually used (≥ options.spacing_m)
   int64_t size() const { return int64_t(x.size() * z.size()); }
   // [nz·nx, 3] float64 (x, height, z), row-major over (z, x).
   torch::Tensor positions() const;

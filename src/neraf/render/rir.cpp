@@ -13,14 +13,14 @@
 namespace neraf::render {
 
 geometry::Vec3 parse_position(const std::string& text, const std::string& flag) {
-  const std::string err = flag + ": expected X,Y,Z (three numbers in metres, e.g. 1.5,1.2,0.9), got \"" +
-                          text + "\"";
+  const std::string err =
+      flag + ": expected X,Y,Z (three numbers in metres, e.g. 1.5,1.2,0.9), got \"" + text + "\"";
   std::vector<double> values;
   size_t start = 0;
   for (;;) {
     const size_t comma = text.find(',', start);
-    const std::string part = text.substr(start, comma == std::string::npos ? std::string::npos
-                                                                          : comma - start);
+    const std::string part =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
     const char* begin = part.c_str();
     char* end = nullptr;
     errno = 0;

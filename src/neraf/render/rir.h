@@ -22,9 +22,9 @@ struct AudioModelInfo {
   data::AudioLayout layout = data::AudioLayout::soundspaces;
   int sample_rate = 22050;  // rate of the waveforms the STFT describes (22050 / 48000)
   dsp::StftParams stft = dsp::StftParams::soundspaces();
-  int channels = 2;        // 2 binaural (SoundSpaces) / 1 (RAF)
-  int64_t max_len = 78;    // STFT frames per RIR
-  data::Aabb aabb;         // the train audio bounding box (train mics ± 1 m), dataset frame
+  int channels = 2;      // 2 binaural (SoundSpaces) / 1 (RAF)
+  int64_t max_len = 78;  // STFT frames per RIR
+  data::Aabb aabb;       // the train audio bounding box (train mics ± 1 m), dataset frame
 };
 
 // Predicted log-magnitudes log(|STFT| + 1e-3) for B poses (dataset frame, metres, y up):
