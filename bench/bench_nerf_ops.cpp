@@ -86,14 +86,13 @@ void hash_fwd(benchmark::State& state, const HashGridConfig& cfg, int64_t spr) {
   finish(state, c.x.size(0));
 }
 
-// The raw backward kernel plus zeroing the gradient buffer, as the op does.
+// The raw backward kernel (it zeroes the gradient buffer itself, level by level).
 void hash_bwd(benchmark::State& state, const HashGridConfig& cfg, int64_t spr) {
   set_threads(state);
   GridCase c = make_case(cfg, spr);
   torch::Tensor grad = torch::empty_like(c.table);
   const int nt = torch::get_num_threads();
   for (auto _ : state) {
-    grad.zero_();
     hash_grid_backward_cpu<float>(c.x.data_ptr<float>(), c.x.size(0), nullptr,
                                   c.upstream.data_ptr<float>(), c.layout, grad.data_ptr<float>(),
                                   nullptr, nt);

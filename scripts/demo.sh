@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The README's main command: the whole neraf story on the built-in demo scene.
-# Installs the Debian packages, builds, then runs each step into demo-out/.
+#   synthesize -> train jointly -> evaluate -> render a RIR, an auralized WAV, a view, a loudness map
+# Installs the Debian packages, builds, then writes everything into demo-out/ (or $NERAF_DEMO_OUT).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -9,9 +10,37 @@ NERAF=build/neraf
 OUT=${NERAF_DEMO_OUT:-demo-out}
 mkdir -p "$OUT"
 
-echo "== metrics of a real measured binaural RIR (assets/real/brir_clap.wav)"
-$NERAF metrics --rir assets/real/brir_clap.wav
-echo "== auralize dry castanets with it"
-$NERAF auralize --rir assets/real/brir_clap.wav --in assets/real/castanets_dry.wav \
-  --out "$OUT/castanets_in_seminar_room.wav" --normalize
-echo "demo outputs in $OUT/"
+# Poses in the dataset's frame as NeRAF reads it (metres, y up); see `neraf render rir --help`.
+MIC=2.0,1.5,2.5
+SRC=1.1,1.2,0.9
+
+step() { printf '\n== %s\n' "$*"; }
+
+step "1/6 synthesize the demo room (pictures + binaural RIRs, SoundSpaces layout)"
+$NERAF synth --preset demo --layout soundspaces --out "$OUT/scene" --seed 1 --force
+$NERAF info "$OUT/scene"
+
+step "2/6 train the radiance and acoustic fields jointly (cpu preset)"
+if [ -d "$OUT/run/checkpoints" ]; then
+  $NERAF train --data "$OUT/scene" --out "$OUT/run" --force
+else
+  $NERAF train --data "$OUT/scene" --out "$OUT/run"
+fi
+
+step "3/6 evaluate on the held-out RIRs and views (with the nearest and linear baselines)"
+$NERAF eval --run "$OUT/run" --json "$OUT/eval.json"
+
+step "4/6 render a RIR at a new pose and auralize speech with it"
+$NERAF render rir --run "$OUT/run" --mic "$MIC" --src "$SRC" --yaw 90 --out "$OUT/rir.wav"
+$NERAF metrics --rir "$OUT/rir.wav"
+espeak-ng -w "$OUT/dry_speech.wav" "This is how the demo room sounds, rendered by neraf."
+$NERAF auralize --run "$OUT/run" --mic "$MIC" --src "$SRC" --yaw 90 \
+  --in "$OUT/dry_speech.wav" --out "$OUT/speech_in_room.wav" --normalize
+
+step "5/6 render a held-out view"
+$NERAF render view --run "$OUT/run" --frame 0 --out "$OUT/view.png" --depth "$OUT/depth.png"
+
+step "6/6 draw the loudness map of the source"
+$NERAF render loudness --run "$OUT/run" --src "$SRC" --yaw 90 --out "$OUT/loudness.png"
+
+printf '\nDemo outputs in %s/: eval.json, rir.wav, speech_in_room.wav, view.png, loudness.png\n' "$OUT"

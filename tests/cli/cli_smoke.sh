@@ -22,7 +22,7 @@ expect_in() {  # expect_in FILE PATTERN
 
 # --- the program and its help -------------------------------------------------------------
 expect_exit 0 "$NERAF" --help
-for cmd in metrics auralize; do expect_in "$TMP/out" "$cmd"; done
+for cmd in metrics auralize synth info train eval render; do expect_in "$TMP/out" "$cmd"; done
 expect_exit 0 "$NERAF" --version
 expect_in "$TMP/out" "LibTorch"
 expect_in "$TMP/out" "openblas"
@@ -30,7 +30,7 @@ expect_exit 2 "$NERAF"
 expect_exit 2 "$NERAF" no-such-command
 expect_exit 2 "$NERAF" metrics --no-such-flag
 expect_in "$TMP/err" "Usage"
-for cmd in metrics auralize; do
+for cmd in metrics auralize synth info train eval render; do
   expect_exit 0 "$NERAF" "$cmd" --help
   expect_in "$TMP/out" "Usage"
 done

@@ -293,7 +293,7 @@ void expect_paths_identical(const HashGridConfig& cfg, const torch::Tensor& x, i
   const HashGridPath paths[2] = {HashGridPath::kBest, HashGridPath::kScalar};
   for (int p = 0; p < 2; ++p) {
     out[p] = torch::empty({n, layout.output_dim()});
-    grad_table[p] = torch::zeros_like(table);
+    grad_table[p] = torch::full_like(table, p == 0 ? 7.f : -3.f);  // must be overwritten
     grad_x[p] = torch::empty({n, 3});
     hash_grid_forward_cpu<float>(x.data_ptr<float>(), n, table.data_ptr<float>(), layout,
                                  out[p].data_ptr<float>(), threads, paths[p]);

@@ -59,6 +59,7 @@ TEST(ScenePresets, FurnishedIsLarger) {
   const Scene demo = preset_scene("demo"), f = preset_scene("furnished");
   EXPECT_GT(f.furniture.size(), demo.furniture.size());
   const auto pf = plan_synthesis(f, "soundspaces", 0), pd = plan_synthesis(demo, "soundspaces", 0);
+  EXPECT_EQ(pf.jobs.size(), 1112u);  // 139 free grid points × 4 headings × 2 sources (presets.h)
   EXPECT_GT(pf.jobs.size(), 3 * pd.jobs.size());
   EXPECT_GT(pf.train_cameras.size(), pd.train_cameras.size());
 }

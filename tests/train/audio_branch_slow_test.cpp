@@ -13,10 +13,10 @@ namespace {
 
 TEST(AudioBranchSlow, JointTrainingReducesTheAudioLoss) {
   torch::manual_seed(0);
-  const std::string dir = testing::make_temp_dir("slow");
-  const data::RirSet rirs = testing::tiny_rir_set(dir);
-  const data::ImageSet images = testing::make_image_set();
-  TrainConfig c = testing::tiny_joint_config();
+  const std::string dir = fixtures::make_temp_dir("slow");
+  const data::RirSet rirs = fixtures::tiny_rir_set(dir);
+  const data::ImageSet images = fixtures::make_image_set();
+  TrainConfig c = fixtures::tiny_joint_config();
   c.steps = 60;
   auto trainer = make_trainer(c, &images, torch::kCPU, &rirs);
   std::vector<double> mag;

@@ -20,10 +20,10 @@ namespace neraf::train {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::make_image_set;
-using testing::make_temp_dir;
-using testing::tiny_joint_config;
-using testing::tiny_rir_set;
+using fixtures::make_image_set;
+using fixtures::make_temp_dir;
+using fixtures::tiny_joint_config;
+using fixtures::tiny_rir_set;
 
 TEST(AudioBranch, JointStepReportsAudioLossesAndTouchesTheGrid) {
   torch::manual_seed(0);
@@ -222,7 +222,7 @@ TEST(AudioEval, RunFolderPredictsAndWritesJsonCsvPng) {
 
 TEST(AudioRun, VisionRunHasNoAcousticField) {
   const std::string dir = make_temp_dir("visiononly");
-  TrainConfig c = testing::tiny_train_config();
+  TrainConfig c = fixtures::tiny_train_config();
   io::write_json_atomically(dir + "/config.json", to_json(c));
   EXPECT_THROW(load_audio_run(dir), Error);
 }

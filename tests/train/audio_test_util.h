@@ -12,7 +12,7 @@
 #include "neraf/train/train_config.h"
 #include "synthetic_scene.h"
 
-namespace neraf::train::testing {
+namespace neraf::train::fixtures {
 
 // A fresh temp folder (removed by the caller's TempDir or left in /tmp).
 inline std::string make_temp_dir(const std::string& tag) {
@@ -38,7 +38,7 @@ inline data::RirSet tiny_rir_set(const std::string& dir, bool move_a_point = fal
 inline TrainConfig tiny_joint_config() {
   TrainConfig c = tiny_train_config();
   c.modality = Modality::joint;
-  c.audio.grid_resolution = 16;
+  c.audio.grid_resolution = 32;  // the cpu ResNet3D needs ≥ 32³ (BatchNorm on 2³ at layer3)
   c.audio.cells_per_update = 512;
   c.audio.batch_size = 64;
   c.audio.start_step = -1;  // audio from the first step
@@ -48,4 +48,4 @@ inline TrainConfig tiny_joint_config() {
   return c;
 }
 
-}  // namespace neraf::train::testing
+}  // namespace neraf::train::fixtures

@@ -1,3 +1,4 @@
+#include "neraf/train/lr_schedule.h"
 #include "neraf/train/checkpoint.h"
 
 #include <gtest/gtest.h>
@@ -61,8 +62,8 @@ TEST(Checkpoint, Names) {
 }
 
 TEST(Checkpoint, SaveLoadRoundTripAndExactResume) {
-  const auto images = testing::make_image_set();
-  const TrainConfig cfg = testing::tiny_train_config();
+  const auto images = fixtures::make_image_set();
+  const TrainConfig cfg = fixtures::tiny_train_config();
   TempDir d;
 
   // Uninterrupted: 6 steps.
@@ -85,8 +86,8 @@ TEST(Checkpoint, SaveLoadRoundTripAndExactResume) {
 }
 
 TEST(Checkpoint, CorruptedOrTruncatedFileIsAClearError) {
-  const auto images = testing::make_image_set();
-  const TrainConfig cfg = testing::tiny_train_config();
+  const auto images = fixtures::make_image_set();
+  const TrainConfig cfg = fixtures::tiny_train_config();
   TempDir d;
   auto t = make_trainer(cfg, &images, torch::kCPU);
   t->step();
@@ -119,8 +120,8 @@ TEST(Checkpoint, CorruptedOrTruncatedFileIsAClearError) {
 }
 
 TEST(Checkpoint, AnotherPresetOrConfigIsRefused) {
-  const auto images = testing::make_image_set();
-  TrainConfig cfg = testing::tiny_train_config();
+  const auto images = fixtures::make_image_set();
+  TrainConfig cfg = fixtures::tiny_train_config();
   TempDir d;
   auto t = make_trainer(cfg, &images, torch::kCPU);
   t->save_checkpoint(d.file("c.pt"));
@@ -150,14 +151,14 @@ TEST(Checkpoint, AnotherPresetOrConfigIsRefused) {
   auto w = make_trainer(longer, &images, torch::kCPU);
   EXPECT_NO_THROW(w->load_checkpoint(d.file("c.pt")));
   // Same config but a dataset with another number of training images: shape mismatch.
-  const auto three = testing::make_image_set(3);
+  const auto three = fixtures::make_image_set(3);
   auto x = make_trainer(cfg, &three, torch::kCPU);
   EXPECT_THROW(x->load_checkpoint(d.file("c.pt")), neraf::Error);
 }
 
 TEST(Trainer, SameSeedSameNumbersAndGroups) {
-  const auto images = testing::make_image_set();
-  const TrainConfig cfg = testing::tiny_train_config();
+  const auto images = fixtures::make_image_set();
+  const TrainConfig cfg = fixtures::tiny_train_config();
   auto a = make_trainer(cfg, &images, torch::kCPU);
   auto b = make_trainer(cfg, &images, torch::kCPU);
   for (int i = 0; i < 3; ++i) {
@@ -180,8 +181,8 @@ TEST(Trainer, SameSeedSameNumbersAndGroups) {
 }
 
 TEST(Trainer, AudioModalityIsNotAvailableYet) {
-  const auto images = testing::make_image_set();
-  TrainConfig cfg = testing::tiny_train_config();
+  const auto images = fixtures::make_image_set();
+  TrainConfig cfg = fixtures::tiny_train_config();
   cfg.modality = Modality::joint;
   EXPECT_THROW(make_trainer(cfg, &images, torch::kCPU), neraf::Error);
 }

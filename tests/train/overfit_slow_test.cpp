@@ -8,9 +8,9 @@
 using namespace neraf::train;
 
 TEST(Overfit, FortyStepsReduceTheLoss) {
-  const auto images = testing::make_image_set(2, 8);
+  const auto images = fixtures::make_image_set(2, 8);
   for (auto precision : {neraf::nerf::Precision::fp32, neraf::nerf::Precision::bf16}) {
-    TrainConfig cfg = testing::tiny_train_config();
+    TrainConfig cfg = fixtures::tiny_train_config();
     cfg.model.precision = precision;
     cfg.rays_per_batch = 128;
     cfg.steps = 60;

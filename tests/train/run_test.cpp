@@ -64,8 +64,8 @@ void write_dataset(const fs::path& dir, const neraf::data::ImageSet& set) {
 TEST(Run, TrainResumeRefuseAndLoad) {
   TempDir tmp("a");
   const fs::path data = tmp.path / "data", run = tmp.path / "run";
-  write_dataset(data, testing::make_image_set(3));
-  TrainConfig cfg = testing::tiny_train_config();
+  write_dataset(data, fixtures::make_image_set(3, 12));  // SSIM needs >= 11 px
+  TrainConfig cfg = fixtures::tiny_train_config();
   cfg.steps = 4;
   cfg.save_every = 2;
   TrainRunOptions o;

@@ -9,7 +9,7 @@
 #include "neraf/data/image_set.h"
 #include "neraf/train/train_config.h"
 
-namespace neraf::train::testing {
+namespace neraf::train::fixtures {
 
 inline torch::Tensor look_at_origin(double angle, double height) {
   const double px = std::cos(angle), pz = std::sin(angle), py = height;
@@ -80,4 +80,4 @@ inline TrainConfig tiny_train_config() {
   return c;
 }
 
-}  // namespace neraf::train::testing
+}  // namespace neraf::train::fixtures

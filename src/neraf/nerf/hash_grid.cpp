@@ -67,7 +67,8 @@ class HashGridFunction : public torch::autograd::Function<HashGridFunction> {
     if (!need_table && !need_x) return {torch::Tensor(), torch::Tensor(), torch::Tensor()};
 
     const auto options = grad_out.options();
-    torch::Tensor grad_table = torch::zeros({layout.total_entries, layout.features()}, options);
+    // Overwritten by the kernel (zeroed level by level where it is about to be used).
+    torch::Tensor grad_table = torch::empty({layout.total_entries, layout.features()}, options);
     torch::Tensor grad_x = need_x ? torch::empty({n, 3}, options) : torch::Tensor();
     torch::Tensor table = need_x ? saved[1].contiguous() : torch::Tensor();
     const int nt = at::get_num_threads();

@@ -66,13 +66,14 @@ template <typename T>
 void hash_grid_forward_cpu(const T* x, int64_t n, const T* table, const HashGridLayout& layout,
                            T* out, int num_threads, HashGridPath path = HashGridPath::kBest);
 
-// Gradient w.r.t. the table, ACCUMULATED into grad_table ([total_entries, F]; zero it first for a
-// plain gradient). grad_out: [n, L·F]. Levels are owned by threads (no atomics); within a level
-// points are accumulated in index order, so the bits do not depend on num_threads. With 2 threads
-// and 16 levels each thread owns 8 levels; there is no parallelism beyond L threads.
-// If grad_x is not null ([n, 3], overwritten) the gradient w.r.t. x is computed too, in a second
-// pass shaped like the forward one (needs `table`, which may be null otherwise; summed over levels
-// in level order, also thread-count independent). It costs about one more forward pass.
+// Gradient w.r.t. the table, written to grad_table ([total_entries, F], fully overwritten: each
+// level's slice is zeroed by its owner thread just before use). grad_out: [n, L·F]. Levels are
+// owned by threads (no atomics); within a level points are accumulated in index order, so the bits
+// do not depend on num_threads. With 2 threads and 16 levels each thread owns 8 levels; there is no
+// parallelism beyond L threads. If grad_x is not null ([n, 3], overwritten) the gradient w.r.t. x
+// is computed too, in a second pass shaped like the forward one (needs `table`, which may be null
+// otherwise; summed over levels in level order, also thread-count independent). It costs about one
+// more forward pass.
 template <typename T>
 void hash_grid_backward_cpu(const T* x, int64_t n, const T* table, const T* grad_out,
                             const HashGridLayout& layout, T* grad_table, T* grad_x, int num_threads,

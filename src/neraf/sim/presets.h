@@ -5,7 +5,7 @@
 //              binaural RIRs (0.6 s), 50 + 10 photos at 96 × 96 — trains in minutes on 2 cores.
 //   shoebox    5 × 3 × 4 m empty room, one uniform material (for Sabine/Eyring checks), 20 × 4 × 1
 //              = 80 RIRs (1 s), 30 + 10 photos at 96 × 96.
-//   furnished  7 × 3 × 6 m, 7 boxes, 0.5 m grid (~130 points) × 4 × 2 sources ≈ 1,050 RIRs
+//   furnished  7 × 3 × 6 m, 7 boxes, 0.5 m grid (139 free points) × 4 × 2 sources = 1,112 RIRs
 //              (0.8 s), 100 + 20 photos at 128 × 128.
 #include <string>
 #include <vector>

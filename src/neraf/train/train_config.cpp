@@ -97,6 +97,7 @@ void validate(const TrainConfig& c, const std::string& where) {
   check_schedule(c.proposal_networks, where + ".proposal_networks");
   check_schedule(c.camera_opt, where + ".camera_opt");
   nerf::validate(c.model, where + ".model");
+  if (c.modality == Modality::vision) return;  // the acoustic settings are unused
   const AudioConfig& a = c.audio;
   require(a.grid == "sampled" || a.grid == "none" || a.grid == "zeros",
           where + ".audio.grid: use sampled, none or zeros (--grid)");
