@@ -87,7 +87,7 @@ TEST(AcousticModel, RenderStftMatchesPerFrameForwardInEvalMode) {
   AcousticModel m(small_options(GridMode::kSampled));
   const auto grid = torch::rand({7, 32, 32, 32});
   m->forward(grid, torch::zeros({1}, torch::kInt64), torch::rand({1, 3}), torch::rand({1, 3}),
-             torch::rand({1, 3}));  // one train-mode pass moves the BN running stats
+             torch::rand({1, 3}));  // a train-mode pass leaves no state behind
   const auto mic = torch::rand({3}, torch::kFloat64), src = torch::rand({3}, torch::kFloat64),
              rot = torch::tensor({0.5, 0.5, 1.0}, torch::kFloat64);
   ASSERT_TRUE(m->is_training());

@@ -80,6 +80,24 @@ TEST(EnergyDecayLoss, HandComputed) {
   EXPECT_NEAR(energy_decay_loss(to_log(mg), to_log(mg)).item<double>(), 0.0, 1e-7);
 }
 
+TEST(EnergyDecayLoss, FloorIgnoresTheCurveFarBelowTheTotalEnergy) {
+  // GT D = (4.27, 0.27, 0.02): a 10 dB floor sits at log10(4.27) − 1 = log10(0.427), so only
+  // frame 0 counts (both curves are clamped at the floor for frames 1 and 2).
+  const double mp[2][3] = {{1.0, 0.5, 0.25}, {0.0, 0.5, 0.0}};
+  const double mg[2][3] = {{2.0, 0.5, 0.1}, {0.0, 0.0, 0.1}};
+  auto to_log = [](const double m[2][3]) {
+    auto t = torch::empty({1, 1, 2, 3}, torch::kFloat64);
+    for (int f = 0; f < 2; ++f)
+      for (int k = 0; k < 3; ++k) t[0][0][f][k] = std::log(m[f][k] + 1e-3);
+    return t;
+  };
+  // pred D = (1.5625, 0.5625, 0.0625) → clamped (1.5625, 0.5625, 0.427).
+  const double want = (std::abs(std::log10(1.5625) - std::log10(4.27)) +
+                       std::abs(std::log10(0.5625) - std::log10(0.427))) /
+                      3.0;
+  EXPECT_NEAR(energy_decay_loss(to_log(mp), to_log(mg), 1e-12, 10.0).item<double>(), want, 1e-5);
+}
+
 TEST(EnergyDecayLoss, SilentTailStaysFiniteAndDifferentiable) {
   auto pred = torch::full({2, 1, 4, 5}, std::log(1e-3), torch::requires_grad());  // M = 0
   const auto gt = torch::zeros({2, 1, 4, 5});

@@ -180,3 +180,32 @@ TEST(NerfactoModel, Bf16ForwardIsCloseToFp32) {
   EXPECT_LT(rel_d, 3e-2);
   EXPECT_LT(rel_c, 1e-2);
 }
+
+TEST(Mlp, FusedOpMatchesTheAutogradReference) {
+  auto g = at::make_generator<at::CPUGeneratorImpl>(21);
+  for (auto p : {Precision::fp32, Precision::bf16}) {
+    Mlp mlp(13, 24, 5, 3, p, 7);
+    auto x = torch::randn({300, 13}, g).requires_grad_(true);
+    auto xr = x.detach().clone().requires_grad_(true);
+    std::vector<torch::Tensor> wr;
+    for (const auto& w : mlp->weights()) wr.push_back(w.detach().clone().requires_grad_(true));
+    const auto coef = torch::randn({300, 5}, g);
+    const auto y = mlp->forward(x), yr = mlp_reference(xr, wr, p);
+    const double tol = p == Precision::fp32 ? 1e-5 : 2e-2;
+    EXPECT_TRUE(torch::allclose(y, yr, tol, tol)) << to_string(p);
+    (y * coef).sum().backward();
+    (yr * coef).sum().backward();
+    EXPECT_TRUE(torch::allclose(x.grad(), xr.grad(), tol, tol)) << to_string(p);
+    for (size_t l = 0; l < wr.size(); ++l) {
+      const auto& a = mlp->weights()[l].grad();
+      const auto& b = wr[l].grad();
+      EXPECT_LT(((a - b).norm() / b.norm()).item<double>(), p == Precision::fp32 ? 1e-5 : 2e-2)
+          << to_string(p) << " layer " << l;
+    }
+  }
+  // No input gradient requested: none computed, weight gradients still there.
+  Mlp mlp(4, 8, 2, 2, Precision::fp32, 1);
+  const auto y = mlp->forward(torch::randn({10, 4}));
+  y.sum().backward();
+  EXPECT_TRUE(mlp->weights()[0].grad().defined());
+}

@@ -66,8 +66,8 @@ TEST(RirFromLogStft, ShapeRateDeterminismAndLevel) {
   std::vector<float> x;
   const torch::Tensor ls = test_log_stft(p, 2, &x);
   const int64_t T = ls.size(2);
-  const io::AudioBuffer a = rir_from_log_stft(ls, p, 22050, {32, 0.99f, 7});
-  const io::AudioBuffer b = rir_from_log_stft(ls, p, 22050, {32, 0.99f, 7});
+  const io::AudioBuffer a = rir_from_log_stft(ls, p, 22050, {7});
+  const io::AudioBuffer b = rir_from_log_stft(ls, p, 22050, {7});
   ASSERT_EQ(a.num_channels(), 2);
   EXPECT_EQ(a.sample_rate, 22050);
   EXPECT_EQ(a.num_frames(), p.hop_length * (T - 1));

@@ -1,7 +1,6 @@
 // Layout formatting: points.txt axis convention, split ratios, RAF quaternions, transforms.json,
 // PNG and WAV bytes.
 #include <gtest/gtest.h>
-#include <stb/stb_image.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -12,8 +11,6 @@
 #include <sstream>
 
 #include "neraf/geometry/pose.h"
-#include "neraf/io/atomic_file.h"
-#include "neraf/io/audio_file.h"
 #include "neraf/sim/layout_writers.h"
 #include "neraf/util/error.h"
 
@@ -196,42 +193,6 @@ TEST(LayoutFormat, TransformsJson) {
   EXPECT_FALSE(nerfstudio_transforms(k, {}, false).contains("orientation_override"));
   EXPECT_EQ(frame_file_name("", 12), "images/frame_00012.png");
   EXPECT_EQ(frame_file_name("eval_", 0), "images/eval_frame_00000.png");
-}
-
-TEST(LayoutFormat, PngRoundTrip) {
-  RgbImage img;
-  img.width = 5;
-  img.height = 3;
-  for (int i = 0; i < 45; ++i) img.pixels.push_back(static_cast<uint8_t>(i * 5 + 1));
-  const auto dir = temp_dir("png");
-  const std::string path = (dir / "images" / "a.png").string();
-  write_png(path, img);
-  int w = 0, h = 0, c = 0;
-  unsigned char* data = stbi_load(path.c_str(), &w, &h, &c, 0);
-  ASSERT_NE(data, nullptr);
-  EXPECT_EQ(w, 5);
-  EXPECT_EQ(h, 3);
-  EXPECT_EQ(c, 3);
-  EXPECT_EQ(std::vector<uint8_t>(data, data + 45), img.pixels);
-  stbi_image_free(data);
-  EXPECT_EQ(encode_png(img), encode_png(img));
-  std::filesystem::remove_all(dir);
-}
-
-TEST(LayoutFormat, WavIsReadableAndHasNoTimestamp) {
-  const auto dir = temp_dir("wav");
-  const std::string path = (dir / "x" / "rir.wav").string();
-  const std::vector<std::vector<float>> ch = {{0.5f, -0.25f, 0.125f, 0.f},
-                                              {0.f, 1.5f, -2.f, 1e-7f}};
-  write_wav_float(path, ch, 44100);
-  const auto audio = io::read_audio(path);
-  EXPECT_EQ(audio.sample_rate, 44100);
-  EXPECT_EQ(audio.channels, ch);  // float WAV keeps values outside [-1, 1] too
-  const std::string bytes = io::read_text_file(path);
-  EXPECT_EQ(bytes.find("PEAK"), std::string::npos);  // libsndfile's PEAK chunk holds a time stamp
-  EXPECT_EQ(bytes.substr(0, 4), "RIFF");
-  EXPECT_THROW(write_wav_float(path, {{0.f, NAN}}, 48000), Error);
-  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

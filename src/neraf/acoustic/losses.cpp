@@ -21,17 +21,24 @@ AudioLossTerms sc_slmse_loss(const torch::Tensor& pred, const torch::Tensor& gt,
   return t;
 }
 
-torch::Tensor energy_decay_loss(const torch::Tensor& pred, const torch::Tensor& gt, double eps) {
+torch::Tensor energy_decay_loss(const torch::Tensor& pred, const torch::Tensor& gt, double eps,
+                                double floor_db) {
   TORCH_CHECK(pred.dim() == 4 && pred.sizes() == gt.sizes(),
               "energy_decay_loss: expected equal [B, C, F, T] shapes, got ", pred.sizes(), " and ",
               gt.sizes());
-  auto decay_db = [eps](const torch::Tensor& log_mag) {
+  auto decay_log10 = [eps](const torch::Tensor& log_mag) {
     const auto m = torch::clamp_min(torch::exp(log_mag.to(torch::kFloat32)) - 1e-3, 0.0);
     const auto e = (m * m).sum(2);                                           // [B, C, T]
     const auto d = torch::flip(torch::cumsum(torch::flip(e, {2}), 2), {2});  // Σ_{τ≥t}
     return torch::log10(d + eps);
   };
-  return torch::abs(decay_db(pred) - decay_db(gt)).mean();
+  torch::Tensor p = decay_log10(pred), g = decay_log10(gt);  // [B, C, T]
+  if (floor_db > 0) {
+    const torch::Tensor floor = g.narrow(2, 0, 1) - floor_db / 10.0;  // [B, C, 1]
+    p = torch::maximum(p, floor);
+    g = torch::maximum(g, floor);
+  }
+  return torch::abs(p - g).mean();
 }
 
 }  // namespace neraf::acoustic

@@ -15,6 +15,9 @@
 //   D_t = Σ_{τ ≥ t} E_τ                          backward cumulative energy (Schroeder curve)
 //   decay = mean over (B, C, T) of |log10(D_t^pred + eps) − log10(D_t^gt + eps)|
 // eps (1e-12) keeps an all-zero tail finite. audio_decay_loss = loss_factor·decay_weight·decay.
+// With floor_db > 0 (ours; training uses 60 dB) both curves are clamped at floor_db below the
+// ground truth's total energy D_0: the last frames' few-ULP energies otherwise dominate the log
+// differences, while T60 (down to −35 dB), EDT and C50 only look at the top of the curve.
 #include <torch/types.h>
 
 namespace neraf::acoustic {
@@ -25,6 +28,7 @@ struct AudioLossOptions {
   double mag_weight = 1.0;
   double decay_weight = 0.0;  // energy-decay term weight (0 = off, the reference)
   double decay_eps = 1e-12;
+  double decay_floor_db = 60.0;
 };
 
 struct AudioLossTerms {
@@ -41,6 +45,6 @@ AudioLossTerms sc_slmse_loss(const torch::Tensor& pred, const torch::Tensor& gt,
 
 // pred, gt: [B, C, F, T] log-magnitudes of whole RIRs → [] raw energy-decay L1 (unweighted).
 torch::Tensor energy_decay_loss(const torch::Tensor& pred, const torch::Tensor& gt,
-                                double eps = 1e-12);
+                                double eps = 1e-12, double floor_db = 0.0);
 
 }  // namespace neraf::acoustic

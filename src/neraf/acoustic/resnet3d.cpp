@@ -35,6 +35,12 @@ nn::Conv3d conv(int64_t in, int64_t out, int64_t kernel, int64_t stride, int64_t
   return nn::Conv3d(nn::Conv3dOptions(in, out, kernel).stride(stride).padding(padding).bias(false));
 }
 
+// BatchNorm over the one grid of a batch, with that grid's own statistics in train AND eval mode
+// (no running statistics; see resnet3d.h for why).
+nn::BatchNorm3d batch_norm(int64_t channels) {
+  return nn::BatchNorm3d(nn::BatchNorm3dOptions(channels).track_running_stats(false));
+}
+
 }  // namespace
 
 ResBlock3dImpl::ResBlock3dImpl(ResBlock kind, int64_t in_channels, int64_t planes, int64_t stride)
@@ -42,21 +48,21 @@ ResBlock3dImpl::ResBlock3dImpl(ResBlock kind, int64_t in_channels, int64_t plane
   const int64_t out_channels = planes * resnet3d_expansion(kind);
   if (kind == ResBlock::kBottleneck) {
     conv1 = register_module("conv1", conv(in_channels, planes, 1, 1, 0));
-    bn1 = register_module("bn1", nn::BatchNorm3d(planes));
+    bn1 = register_module("bn1", batch_norm(planes));
     conv2 = register_module("conv2", conv(planes, planes, 3, stride, 1));
-    bn2 = register_module("bn2", nn::BatchNorm3d(planes));
+    bn2 = register_module("bn2", batch_norm(planes));
     conv3 = register_module("conv3", conv(planes, out_channels, 1, 1, 0));
-    bn3 = register_module("bn3", nn::BatchNorm3d(out_channels));
+    bn3 = register_module("bn3", batch_norm(out_channels));
   } else {
     conv1 = register_module("conv1", conv(in_channels, planes, 3, stride, 1));
-    bn1 = register_module("bn1", nn::BatchNorm3d(planes));
+    bn1 = register_module("bn1", batch_norm(planes));
     conv2 = register_module("conv2", conv(planes, planes, 3, 1, 1));
-    bn2 = register_module("bn2", nn::BatchNorm3d(planes));
+    bn2 = register_module("bn2", batch_norm(planes));
   }
   if (stride != 1 || in_channels != out_channels) {
     downsample =
         register_module("downsample", nn::Sequential(conv(in_channels, out_channels, 1, stride, 0),
-                                                     nn::BatchNorm3d(out_channels)));
+                                                     batch_norm(out_channels)));
   }
 }
 
@@ -81,7 +87,7 @@ ResNet3dImpl::ResNet3dImpl(ResNet3dOptions options) : options_(std::move(options
           "resnet3d: layers, planes and strides must be non-empty and of equal length");
   conv1 = register_module(
       "conv1", conv(o.in_channels, o.stem_channels, o.stem_kernel, 2, o.stem_kernel / 2));
-  bn1 = register_module("bn1", nn::BatchNorm3d(o.stem_channels));
+  bn1 = register_module("bn1", batch_norm(o.stem_channels));
   int64_t in = o.stem_channels;
   for (size_t s = 0; s < o.layers.size(); ++s) {
     require(o.layers[s] >= 1 && o.planes[s] >= 1 && o.strides[s] >= 1,

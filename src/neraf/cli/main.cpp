@@ -33,6 +33,7 @@ const CLI::App* selected_command(const CLI::App& app) {
 
 int main(int argc, char** argv) {
   tune_malloc();
+  neraf::cli::use_all_cores();
   CLI::App app{
       "neraf: neural radiance and acoustic fields (NeRAF) on the CPU.\n"
       "Learns a room's pictures and impulse responses jointly; renders, evaluates and auralizes."};

@@ -2,9 +2,20 @@
 
 #include <torch/torch.h>
 
+#include <sched.h>
+
+#include <algorithm>
+#include <cstdlib>
 #include <fstream>
 
 namespace neraf::cli {
+
+void use_all_cores() {
+  if (std::getenv("OMP_NUM_THREADS") != nullptr) return;
+  cpu_set_t allowed;
+  const int cores = sched_getaffinity(0, sizeof(allowed), &allowed) == 0 ? CPU_COUNT(&allowed) : 1;
+  torch::set_num_threads(std::max(1, cores));
+}
 
 std::string loaded_blas_library() {
   // A product large enough to go through BLAS (small ones may take a native path).

@@ -3,6 +3,10 @@
 
 namespace neraf::cli {
 
+// LibTorch 1.13 from Debian starts with one intra-op thread; use every core the process may run
+// on unless OMP_NUM_THREADS says otherwise (`--threads` options still override this later).
+void use_all_cores();
+
 // "neraf 0.1.0" plus LibTorch version, thread count and the BLAS library actually loaded.
 std::string version_text();
 

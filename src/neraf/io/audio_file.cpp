@@ -165,6 +165,8 @@ void write_audio(const std::string& path, const AudioBuffer& audio, AudioFormat 
     }
     // Integer formats: clip out-of-range samples instead of letting them wrap around.
     sf_command(file.get(), SFC_SET_CLIPPING, nullptr, SF_TRUE);
+    // No PEAK chunk: it holds a time stamp, and the same samples must give the same bytes.
+    sf_command(file.get(), SFC_SET_ADD_PEAK_CHUNK, nullptr, SF_FALSE);
 
     std::vector<float> interleaved(std::min<size_t>(n, kChunkFrames) * nc);
     size_t done = 0;

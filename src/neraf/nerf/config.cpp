@@ -1,5 +1,7 @@
 #include "neraf/nerf/config.h"
 
+#include <cmath>
+
 #include <fstream>
 #include <sstream>
 
@@ -53,13 +55,15 @@ ModelConfig model_preset(const std::string& name) {
   // cpu: the demo rooms are small and seen from inside at ~100 px, so a 2^17 table up to
   // resolution 512 already resolves the texture, and the proposal + nerf sample counts can be
   // lowered by about half without visible loss; the camera poses of simulated data are exact,
-  // so the pose optimizer (which needs positional gradients through the hash grid) is off.
+  // so the pose optimizer (which needs positional gradients through the hash grid) is off;
+  // appearance embeddings start small (see FieldConfig::appearance_init_std).
   c.field.grid = HashGridConfig{16, 2, 17, 16, 512};
   c.proposal_nets = {ProposalNetConfig{{5, 2, 16, 16, 128}, 2, 16},
                      ProposalNetConfig{{5, 2, 16, 16, 256}, 2, 16}};
   c.sampler.proposal_samples = {128, 64};
   c.sampler.nerf_samples = 32;
   c.camera_opt.mode = CameraOptMode::off;
+  c.field.appearance_init_std = 0.01;
   return c;
 }
 
@@ -82,6 +86,8 @@ void validate(const ModelConfig& c, const std::string& where) {
   require(c.field.num_layers >= 1, where + ".field.num_layers: must be at least 1");
   require(c.field.hidden_dim >= 1, where + ".field.hidden_dim: must be positive");
   require(c.field.geo_feat_dim >= 1, where + ".field.geo_feat_dim: must be positive");
+  require(c.field.appearance_init_std >= 0 && std::isfinite(c.field.appearance_init_std),
+          where + ".field.appearance_init_std: must be a number >= 0");
   require(c.field.num_layers_color >= 1, where + ".field.num_layers_color: must be at least 1");
   require(c.field.hidden_dim_color >= 1, where + ".field.hidden_dim_color: must be positive");
   require(c.field.appearance_dim >= 0, where + ".field.appearance_dim: must be >= 0");

@@ -39,6 +39,11 @@ struct FieldConfig {  // nerfstudio NerfactoField
   int num_layers_color = 3;  // colour MLP: SH + geo + appearance → 64 → 64 → 3
   int hidden_dim_color = 64;
   int appearance_dim = 32;
+  // Standard deviation of the embeddings' initial values: 1 is torch.nn.Embedding's (nerfstudio).
+  // Then every embedding is a distinct random code and their mean, used for held-out views, is
+  // unlike any of them: on exposure-stable captures the colour of held-out views shifts. Small
+  // initial codes start as one cloud whose mean stays inside it (the cpu preset's 0.01).
+  double appearance_init_std = 1.0;
   int sh_degree = 4;                    // 16 direction features
   double average_init_density = 0.01;   // NeRAF / nerfacto preset (model default would be 1.0)
   bool use_average_appearance_embedding = true;  // eval: mean embedding (else zeros)
@@ -52,6 +57,7 @@ struct FieldConfig {  // nerfstudio NerfactoField
     v("num_layers_color", num_layers_color);
     v("hidden_dim_color", hidden_dim_color);
     v("appearance_dim", appearance_dim);
+    v("appearance_init_std", appearance_init_std);
     v("sh_degree", sh_degree);
     v("average_init_density", average_init_density);
     v("use_average_appearance_embedding", use_average_appearance_embedding);

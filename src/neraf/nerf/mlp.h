@@ -20,7 +20,8 @@ class MlpImpl : public torch::nn::Module {
   MlpImpl(int in_dim, int hidden_dim, int out_dim, int num_layers, Precision precision,
           uint64_t seed);
 
-  // x: [N, in_dim] float32 → [N, out_dim] float32.
+  // x: [N, in_dim] float32 → [N, out_dim] float32. One fused autograd node (see mlp.cpp);
+  // gradients w.r.t. the weights always, w.r.t. x when x requires grad.
   torch::Tensor forward(const torch::Tensor& x);
 
   int in_dim() const { return in_dim_; }
@@ -35,6 +36,11 @@ class MlpImpl : public torch::nn::Module {
   std::vector<torch::Tensor> weights_;  // registered as "w0", "w1", ...
 };
 TORCH_MODULE(Mlp);
+
+// The same MLP written with plain LibTorch ops and autograd (the reference the fused op is tested
+// against).
+torch::Tensor mlp_reference(const torch::Tensor& x, const std::vector<torch::Tensor>& weights,
+                            Precision precision);
 
 // exp(x) whose backward clamps x to [−15, 15] (nerfstudio trunc_exp): keeps density gradients
 // finite when the raw density drifts far negative or positive.

@@ -19,11 +19,12 @@ NerfactoFieldImpl::NerfactoFieldImpl(const FieldConfig& config, int64_t num_trai
   mlp_head = register_module(
       "mlp_head", Mlp(sh_dim + config.geo_feat_dim + config.appearance_dim,
                       config.hidden_dim_color, 3, config.num_layers_color, precision, seed + 3));
-  // torch.nn.Embedding's initialisation: N(0, 1).
+  // N(0, appearance_init_std²); torch.nn.Embedding's initialisation is N(0, 1).
   auto gen = at::make_generator<at::CPUGeneratorImpl>(seed + 4);
   embedding_appearance = register_parameter(
       "embedding_appearance",
-      torch::randn({num_train_images, config.appearance_dim}, gen, torch::kFloat32));
+      torch::randn({num_train_images, config.appearance_dim}, gen, torch::kFloat32) *
+          config.appearance_init_std);
 }
 
 void NerfactoFieldImpl::set_precision(Precision p) {

@@ -8,11 +8,6 @@
 
 namespace neraf::render {
 
-// Viridis-like perceptually ordered map (dark purple → blue → green → yellow), linear between 9
-// stops taken from matplotlib's viridis at t = 0, 1/8, ..., 1. t [...] (clamped to [0, 1]) →
-// [..., 3] float in [0, 1].
-torch::Tensor viridis(const torch::Tensor& t);
-
 // An RGB canvas [H, W, 3] float in [0, 1] with simple drawing operations (all clip at the edges).
 class Canvas {
  public:

@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <vector>
 
-#include "neraf/dsp/griffin_lim.h"
+#include "neraf/train/audio_run.h"
 #include "neraf/util/error.h"
 
 namespace neraf::render {
@@ -43,30 +43,14 @@ bool inside_open_box(const geometry::Vec3& p, const data::Aabb& box) {
   return true;
 }
 
-torch::Tensor log_stft_to_magnitude(const torch::Tensor& log_stft) {
-  return (log_stft.to(torch::kFloat32).exp() - 1e-3).clamp(0.0, 1e4);
-}
-
 io::AudioBuffer rir_from_log_stft(const torch::Tensor& log_stft, const dsp::StftParams& stft,
                                   int sample_rate, const RirRenderOptions& options) {
   TORCH_CHECK(log_stft.dim() == 3, "rir_from_log_stft: expected [C, F, T]");
   TORCH_CHECK(log_stft.size(1) == stft.n_freq(), "rir_from_log_stft: F does not match n_fft");
-  const torch::Tensor mag = log_stft_to_magnitude(log_stft).cpu().contiguous();
-  const int C = static_cast<int>(mag.size(0)), F = static_cast<int>(mag.size(1)),
-            T = static_cast<int>(mag.size(2));
-  std::vector<dsp::Matrix> channels(C, dsp::Matrix(F, T));
-  const float* p = mag.data_ptr<float>();
-  for (int c = 0; c < C; ++c) {
-    std::copy(p + size_t(c) * F * T, p + size_t(c + 1) * F * T, channels[c].data.begin());
-  }
-  dsp::GriffinLimOptions gl;
-  gl.n_iter = options.n_iter;
-  gl.momentum = options.momentum;
-  gl.rand_init = true;
-  gl.seed = options.seed;
   io::AudioBuffer out;
   out.sample_rate = sample_rate;
-  out.channels = dsp::griffin_lim(channels, stft, gl);
+  out.channels = train::griffin_lim_channels(train::log_stft_to_magnitude(log_stft.cpu()), stft,
+                                             options.seed);
   return out;
 }
 

@@ -42,14 +42,8 @@ geometry::Vec3 parse_position(const std::string& text, const std::string& flag);
 // prediction there is not about that position any more.
 bool inside_open_box(const geometry::Vec3& p, const data::Aabb& box);
 
-// clip(exp(x) − 1e-3, 0, 1e4): the linear magnitude of a predicted log-magnitude (what the
-// reference feeds Griffin-Lim and the loudness RMS). Any shape; float32 out.
-torch::Tensor log_stft_to_magnitude(const torch::Tensor& log_stft);
-
 struct RirRenderOptions {
-  int n_iter = 32;         // Griffin-Lim iterations (reference: 32)
-  float momentum = 0.99f;  // reference: 0.99
-  uint64_t seed = 0;       // initial random phases
+  uint64_t seed = 0;  // Griffin-Lim's initial random phases (32 iterations, momentum 0.99)
 };
 
 // Predicted log-magnitude [C, F, T] → waveform (C channels, hop·(T − 1) samples, `sample_rate`).

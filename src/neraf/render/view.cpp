@@ -12,27 +12,6 @@
 
 namespace neraf::render {
 
-torch::Tensor depth_colormap(const torch::Tensor& t) {
-  // Control points of the ramp (evenly spaced in t): dark blue, blue, cyan, green, yellow,
-  // orange, dark red.
-  static const float kStops[7][3] = {{0.19f, 0.07f, 0.23f}, {0.16f, 0.45f, 0.95f},
-                                     {0.10f, 0.85f, 0.80f}, {0.40f, 0.95f, 0.30f},
-                                     {0.95f, 0.85f, 0.20f}, {0.95f, 0.45f, 0.10f},
-                                     {0.50f, 0.02f, 0.01f}};
-  const torch::Tensor stops = torch::from_blob(const_cast<float*>(&kStops[0][0]), {7, 3},
-                                               torch::kFloat32)
-                                  .to(t.device());
-  const torch::Tensor x = t.to(torch::kFloat32).clamp(0.0, 1.0) * 6.0;
-  const torch::Tensor lo = x.floor().clamp(0, 5).to(torch::kInt64);
-  const torch::Tensor f = (x - lo.to(torch::kFloat32)).unsqueeze(-1);
-  const auto shape = lo.sizes().vec();
-  const torch::Tensor a = stops.index_select(0, lo.reshape({-1})).view({-1, 3});
-  const torch::Tensor b = stops.index_select(0, (lo + 1).reshape({-1})).view({-1, 3});
-  std::vector<int64_t> out_shape = shape;
-  out_shape.push_back(3);
-  return (a.view(out_shape) * (1.0 - f) + b.view(out_shape) * f);
-}
-
 torch::Tensor colorize_depth(const torch::Tensor& depth, double near, double far) {
   const torch::Tensor d = depth.to(torch::kFloat32);
   if (!(near < far)) {
@@ -41,7 +20,7 @@ torch::Tensor colorize_depth(const torch::Tensor& depth, double near, double far
     far = torch::quantile(flat, 0.99).item<double>();
     if (!(far > near)) far = near + 1e-6;
   }
-  return depth_colormap((d - near) / (far - near));
+  return train::viridis((d - near) / (far - near));
 }
 
 torch::Tensor normalize_pose(const torch::Tensor& c2w, const torch::Tensor& world_transform,

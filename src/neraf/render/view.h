@@ -11,12 +11,9 @@
 namespace neraf::render {
 
 // Depth → colour: depth normalised between `near` and `far` (when near ≥ far: the 1st and 99th
-// percentiles of the image), then a blue → cyan → green → yellow → red ramp (near = blue).
+// percentiles of the image), then the viridis ramp (near = dark purple).
 // depth: [H, W] → [H, W, 3] float in [0, 1].
 torch::Tensor colorize_depth(const torch::Tensor& depth, double near = 0, double far = 0);
-
-// The colour ramp itself: t [...] in [0, 1] → [..., 3].
-torch::Tensor depth_colormap(const torch::Tensor& t);
 
 struct Camera {
   torch::Tensor c2w;  // [3, 4] float32, normalised (model) frame

@@ -1,15 +1,8 @@
 #include "neraf/sim/layout_writers.h"
 
-#include <sndfile.h>
-// The implementation of stb_image_write comes from Debian's libstb (linked by the sim stage).
-#include <stb/stb_image_write.h>
-
 #include <cmath>
 #include <cstdio>
-#include <fstream>
-#include <memory>
 
-#include "neraf/io/atomic_file.h"
 #include "neraf/sim/seeded_random.h"
 #include "neraf/util/error.h"
 
@@ -60,64 +53,6 @@ std::string frame_file_name(const std::string& prefix, int index) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%05d", index);
   return "images/" + prefix + "frame_" + buf + ".png";
-}
-
-std::vector<uint8_t> encode_png(const RgbImage& image) {
-  std::vector<uint8_t> bytes;
-  const auto append = [](void* ctx, void* data, int size) {
-    auto* out = static_cast<std::vector<uint8_t>*>(ctx);
-    const auto* p = static_cast<const uint8_t*>(data);
-    out->insert(out->end(), p, p + size);
-  };
-  const int ok = stbi_write_png_to_func(append, &bytes, image.width, image.height, 3,
-                                        image.pixels.data(), image.width * 3);
-  if (!ok)
-    throw Error("PNG encoding failed for a " + std::to_string(image.width) + "x" +
-                std::to_string(image.height) + " image");
-  return bytes;
-}
-
-void write_png(const std::string& path, const RgbImage& image) {
-  const auto bytes = encode_png(image);
-  io::write_atomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()),
-              static_cast<std::streamsize>(bytes.size()));
-    out.flush();
-    require(out.good(), path + ": write failed (disk full?); free space and retry");
-  });
-}
-
-void write_wav_float(const std::string& path, const std::vector<std::vector<float>>& channels,
-                     int sample_rate) {
-  require(!channels.empty(), path + ": nothing to write (no audio channels)");
-  const size_t n = channels[0].size();
-  const int nc = static_cast<int>(channels.size());
-  for (const auto& ch : channels) {
-    require(ch.size() == n, path + ": all audio channels must have the same length");
-    for (float v : ch)
-      require(std::isfinite(v), path + ": refusing to write NaN or infinite samples");
-  }
-  std::vector<float> interleaved(n * nc);
-  for (size_t i = 0; i < n; ++i) {
-    for (int c = 0; c < nc; ++c) interleaved[i * nc + c] = channels[c][i];
-  }
-  io::write_atomically(path, [&](const std::string& tmp) {
-    SF_INFO info{};
-    info.samplerate = sample_rate;
-    info.channels = nc;
-    info.format = SF_FORMAT_WAV | SF_FORMAT_FLOAT;
-    SNDFILE* file = sf_open(tmp.c_str(), SFM_WRITE, &info);
-    if (!file)
-      throw Error(path + ": cannot open for writing (" + sf_strerror(nullptr) +
-                  "); choose a writable output path");
-    // The PEAK chunk stores the wall-clock time of writing: drop it for reproducible files.
-    sf_command(file, SFC_SET_ADD_PEAK_CHUNK, nullptr, SF_FALSE);
-    const sf_count_t wrote = sf_writef_float(file, interleaved.data(), static_cast<sf_count_t>(n));
-    const int rc = sf_close(file);
-    require(wrote == static_cast<sf_count_t>(n) && rc == 0,
-            path + ": write failed (disk full?); free space and retry");
-  });
 }
 
 Vec3 world_to_soundspaces(Vec3 w) { return {w.x, -w.z, w.y}; }

@@ -39,18 +39,6 @@ std::vector<int> fraction_train_indices(int n, double train_fraction = 0.9);
 // "images/train_frame_00012.png" style names (5 digits).
 std::string frame_file_name(const std::string& prefix, int index);
 
-// Encodes an 8-bit RGB PNG (stb_image_write) and writes it atomically.
-void write_png(const std::string& path, const RgbImage& image);
-std::vector<uint8_t> encode_png(const RgbImage& image);
-
-// ---------------------------------------------------------------- audio
-
-// 32-bit float WAV, planar channels of equal length, written atomically. Unlike io::write_audio
-// the bytes are a pure function of the samples (libsndfile's PEAK chunk, which holds a time
-// stamp, is switched off), so the same seed gives byte-identical datasets.
-void write_wav_float(const std::string& path, const std::vector<std::vector<float>>& channels,
-                     int sample_rate);
-
 // ---------------------------------------------------------------- SoundSpaces (NeRAF layout)
 
 // metadata/points.txt holds SoundSpaces' z-up coordinates; NeRAF maps a row (x, y, z) to the

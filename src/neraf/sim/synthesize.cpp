@@ -13,7 +13,9 @@
 #include <set>
 
 #include "neraf/io/atomic_file.h"
+#include "neraf/io/audio_file.h"
 #include "neraf/io/json_file.h"
+#include "neraf/io/png.h"
 #include "neraf/sim/hrtf.h"
 #include "neraf/sim/image_renderer.h"
 #include "neraf/sim/layout_writers.h"
@@ -119,7 +121,7 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
     for (size_t i = 0; i < shots.size(); ++i) {
       const RgbImage img =
           renderer.render(*shots[i].first, scene.cameras.supersampling);  // OpenMP rows
-      write_png(out(shots[i].second), img);
+      io::write_png(out(shots[i].second), img.width, img.height, 3, img.pixels.data());
       frames.push_back({shots[i].second, shots[i].first->pose});
       progress.update(static_cast<int64_t>(i + 1));
     }
@@ -201,7 +203,8 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
       for (auto& ch : channels)
         for (float& v : ch) v *= gain;
       peaks[i] = peak_of(channels);
-      write_wav_float(out(job.file), channels, plan.sample_rate);
+      io::write_audio(out(job.file), {plan.sample_rate, std::move(channels)},
+                      io::AudioFormat::wav_float);
       if (!soundspaces) {
         const std::string dir = "data/" + job.name + "/";
         io::write_text_atomically(out(dir + "rx_pos.txt"),

@@ -57,7 +57,6 @@ AudioBranch::AudioBranch(const TrainConfig& config, const data::RirSet& rirs,
   grid_ = acoustic::GridSampler(opts.grid);
   grid_->to(device_);
   train_rirs_ = audio_train_subset(rirs_, config_.audio.fraction, config_.seed);
-  batch_ = torch::empty({config_.audio.batch_size, rirs_.channels, rirs_.n_freq}, torch::kFloat32);
   if (frozen_ && opts.grid_mode == acoustic::GridMode::kSampled) {
     // The paper's separate training: the field is final, so the whole grid is filled once.
     field_->eval();
@@ -106,36 +105,73 @@ LossDict AudioBranch::losses(StepContext& ctx) {
   const int64_t T = rirs_.max_len;
   const int64_t n = static_cast<int64_t>(train_rirs_.size()) * T;
   const int64_t B = config_.audio.batch_size;
+  // Early slices: a share of the batch drawn from the first early_frames frames of random RIRs.
+  const int64_t B_early =
+      std::llround(config_.audio.early_fraction * static_cast<double>(B));
+  const int64_t B_uniform = B - B_early;
   // Shuffled (RIR, frame) slices, epoch-wise without replacement (the reference's DataLoader).
   std::vector<int64_t> picks;
   picks.reserve(static_cast<size_t>(B));
-  while (static_cast<int64_t>(picks.size()) < B) {
+  while (static_cast<int64_t>(picks.size()) < B_uniform) {
     if (!perm_.defined() || cursor_ >= perm_.size(0)) {
       perm_ = torch::randperm(n, ctx.gen, torch::kInt64);
       cursor_ = 0;
     }
-    const int64_t take = std::min(B - static_cast<int64_t>(picks.size()), perm_.size(0) - cursor_);
+    const int64_t take =
+        std::min(B_uniform - static_cast<int64_t>(picks.size()), perm_.size(0) - cursor_);
     const int64_t* p = perm_.data_ptr<int64_t>() + cursor_;
     picks.insert(picks.end(), p, p + take);
     cursor_ += take;
   }
-  const torch::Tensor slice = torch::tensor(picks, torch::kInt64);
-  const torch::Tensor local = torch::div(slice, T, "floor");
-  const torch::Tensor frame = slice - local * T;
-  const torch::Tensor rir =
-      torch::tensor(train_rirs_, torch::kInt64).index_select(0, local);  // [B]
+  torch::Tensor rir_index = torch::tensor(train_rirs_, torch::kInt64);
+  torch::Tensor slice = torch::tensor(picks, torch::kInt64);
+  torch::Tensor local = torch::div(slice, T, "floor");
+  torch::Tensor frame = slice - local * T;  // [B_uniform]
+  if (B_early > 0) {
+    const int64_t early = std::min(T, config_.audio.early_frames);
+    local = torch::cat({local, torch::randint(rir_index.size(0), {B_early}, ctx.gen, torch::kInt64)});
+    frame = torch::cat({frame, torch::randint(early, {B_early}, ctx.gen, torch::kInt64)});
+  }
+  torch::Tensor rir = rir_index.index_select(0, local);  // [B]
+  // Energy-decay loss: D whole RIRs (all T frames, in order) appended to the same batch, so the
+  // scene encoder runs once per step.
+  const double decay_weight = config_.audio.decay_weight;
+  const int64_t D = decay_weight > 0 ? std::min<int64_t>(config_.audio.decay_rirs,
+                                                         rir_index.size(0))
+                                     : 0;
+  if (D > 0) {
+    const torch::Tensor whole =
+        rir_index.index_select(0, torch::randperm(rir_index.size(0), ctx.gen).slice(0, 0, D));
+    rir = torch::cat({rir, whole.repeat_interleave(T)});
+    frame = torch::cat({frame, torch::arange(T, torch::kInt64).repeat({D})});
+  }
+  if (!batch_.defined() || batch_.size(0) != rir.size(0))
+    batch_ = torch::empty({rir.size(0), rirs_.channels, rirs_.n_freq}, torch::kFloat32);
   rirs_.gather_into(rir, frame, batch_);
-  const torch::Tensor gt = batch_.to(device_);  // [B, C, F]
+  const torch::Tensor gt = batch_.to(device_);  // [B + D·T, C, F]
   const torch::Tensor mic =
       data::normalize_position(rirs_.mic_positions.index_select(0, rir), rirs_.audio_aabb);
   const torch::Tensor src =
       data::normalize_position(rirs_.source_positions.index_select(0, rir), rirs_.audio_aabb);
   const torch::Tensor rot = rirs_.rots.index_select(0, rir);
   const torch::Tensor pred = model_->forward(grid_->grid(), frame.to(device_), mic.to(device_),
-                                             src.to(device_), rot.to(device_));  // [B, C, F]
-  const acoustic::AudioLossTerms terms = acoustic::sc_slmse_loss(pred, gt);
+                                             src.to(device_), rot.to(device_));  // [B + D·T, C, F]
+  const acoustic::AudioLossTerms terms =
+      acoustic::sc_slmse_loss(pred.slice(0, 0, B), gt.slice(0, 0, B));
   ctx.metrics["audio_sl"] = terms.sl.item<double>();
-  return {{"audio_sc_loss", terms.sc_loss}, {"audio_mag_loss", terms.mag_loss}};
+  LossDict out{{"audio_sc_loss", terms.sc_loss}, {"audio_mag_loss", terms.mag_loss}};
+  if (D > 0) {
+    // [D·T, C, F] → [D, C, F, T]
+    auto whole_rirs = [&](const torch::Tensor& x) {
+      return x.slice(0, B).view({D, T, x.size(1), x.size(2)}).permute({0, 2, 3, 1});
+    };
+    const acoustic::AudioLossOptions lo;
+    const torch::Tensor decay = acoustic::energy_decay_loss(whole_rirs(pred), whole_rirs(gt),
+                                                            lo.decay_eps, lo.decay_floor_db);
+    ctx.metrics["audio_decay"] = decay.item<double>();
+    out["audio_decay_loss"] = lo.loss_factor * decay_weight * decay;
+  }
+  return out;
 }
 
 void AudioBranch::save(torch::serialize::OutputArchive& archive) {

@@ -54,19 +54,6 @@ std::vector<int64_t> test_indices(const data::RirSet& rirs, int64_t max_rirs) {
   return t;
 }
 
-// Magma-like colour map: t ∈ [0, 1] → RGB in [0, 1] (piecewise linear through 5 stops).
-void colormap(double t, float* rgb) {
-  static const float stops[5][3] = {{0.0f, 0.0f, 0.02f},
-                                    {0.23f, 0.06f, 0.44f},
-                                    {0.71f, 0.21f, 0.48f},
-                                    {0.98f, 0.53f, 0.38f},
-                                    {0.99f, 0.99f, 0.75f}};
-  t = std::clamp(t, 0.0, 1.0) * 4.0;
-  const int i = std::min(3, static_cast<int>(t));
-  const float f = static_cast<float>(t - i);
-  for (int c = 0; c < 3; ++c) rgb[c] = stops[i][c] * (1 - f) + stops[i + 1][c] * f;
-}
-
 }  // namespace
 
 std::vector<int64_t> nearest_training_rirs(const data::RirSet& rirs,
@@ -255,27 +242,13 @@ void write_stft_comparison_png(const std::string& path, const torch::Tensor& pre
   const torch::Tensor g = gt[0].to(torch::kFloat32).flip({0}).contiguous();
   const double lo = std::min(p.min().item<double>(), g.min().item<double>());
   const double hi = std::max(p.max().item<double>(), g.max().item<double>());
-  const int64_t F = p.size(0), T = p.size(1), Tg = g.size(1), gap = 2, s = 3;
-  const int64_t W = (T + gap + Tg) * s, H = F * s;
-  torch::Tensor img = torch::ones({H, W, 3}, torch::kFloat32);
-  float* out = img.data_ptr<float>();
-  auto paint = [&](const torch::Tensor& m, int64_t x0) {
-    const float* v = m.data_ptr<float>();
-    for (int64_t f = 0; f < m.size(0); ++f)
-      for (int64_t t = 0; t < m.size(1); ++t) {
-        float rgb[3];
-        colormap((v[f * m.size(1) + t] - lo) / std::max(hi - lo, 1e-9), rgb);
-        for (int64_t dy = 0; dy < s; ++dy)
-          for (int64_t dx = 0; dx < s; ++dx) {
-            float* px = out + ((f * s + dy) * W + (x0 + t) * s + dx) * 3;
-            px[0] = rgb[0];
-            px[1] = rgb[1];
-            px[2] = rgb[2];
-          }
-      }
-  };
-  paint(p, 0);
-  paint(g, T + gap);
+  const int64_t F = p.size(0), gap = 2, scale = 3;
+  auto colour = [&](const torch::Tensor& m) { return viridis((m - lo) / std::max(hi - lo, 1e-9)); };
+  // [F, T + gap + Tg, 3] white gap between the two, then each pixel drawn as scale × scale.
+  torch::Tensor img =
+      torch::cat({colour(p), torch::ones({F, gap, 3}), colour(g)}, 1)
+          .repeat_interleave(scale, 0)
+          .repeat_interleave(scale, 1);
   write_png(path, img);
 }
 

@@ -76,7 +76,7 @@ void write_audio_csv(const std::string& path, const AudioEval& e);
 std::string audio_table(const std::vector<AudioMethodEval>& methods);
 
 // [C, F, T] log-STFTs → one PNG: prediction (left) | ground truth (right), channel 0, low
-// frequencies at the bottom, common colour scale (magma-like), each pixel 3×3.
+// frequencies at the bottom, common colour scale (viridis), each pixel 3×3.
 void write_stft_comparison_png(const std::string& path, const torch::Tensor& pred,
                                const torch::Tensor& gt);
 

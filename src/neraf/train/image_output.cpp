@@ -1,16 +1,8 @@
 #include "neraf/train/image_output.h"
 
-// stb_image_write's implementation is compiled into Debian's libstb (linked through neraf_data).
-#include <stb/stb_image_write.h>
 #include <torch/torch.h>
 
-#include <cerrno>
-#include <cstring>
-#include <fstream>
-#include <vector>
-
-#include "neraf/io/atomic_file.h"
-#include "neraf/util/error.h"
+#include "neraf/io/png.h"
 
 namespace neraf::train {
 
@@ -18,32 +10,32 @@ torch::Tensor to_uint8(const torch::Tensor& image) {
   return (image.to(torch::kFloat32).clamp(0.0, 1.0) * 255.0).round().to(torch::kUInt8);
 }
 
-namespace {
-void append_bytes(void* context, void* data, int size) {
-  auto* out = static_cast<std::vector<unsigned char>*>(context);
-  const auto* p = static_cast<const unsigned char*>(data);
-  out->insert(out->end(), p, p + size);
+torch::Tensor viridis(const torch::Tensor& t) {
+  static const float kStops[9][3] = {
+      {0.267004f, 0.004874f, 0.329415f}, {0.282623f, 0.140926f, 0.457517f},
+      {0.229739f, 0.322361f, 0.545706f}, {0.172719f, 0.448791f, 0.557885f},
+      {0.127568f, 0.566949f, 0.550556f}, {0.134692f, 0.658636f, 0.517649f},
+      {0.369214f, 0.788888f, 0.382914f}, {0.688944f, 0.865448f, 0.182725f},
+      {0.993248f, 0.906157f, 0.143936f}};
+  const torch::Tensor stops =
+      torch::from_blob(const_cast<float*>(&kStops[0][0]), {9, 3}, torch::kFloat32).clone();
+  const torch::Tensor x = t.to(torch::kFloat32).clamp(0.0, 1.0).reshape({-1}) * 8.0;
+  const torch::Tensor lo = x.floor().clamp(0, 7).to(torch::kInt64);
+  const torch::Tensor f = (x - lo.to(torch::kFloat32)).unsqueeze(-1);
+  const torch::Tensor a = stops.index_select(0, lo);
+  const torch::Tensor b = stops.index_select(0, lo + 1);
+  std::vector<int64_t> shape = t.sizes().vec();
+  shape.push_back(3);
+  return (a * (1.0 - f) + b * f).view(shape);
 }
-}  // namespace
 
 void write_png(const std::string& path, const torch::Tensor& image) {
   TORCH_CHECK(image.dim() == 3 && (image.size(2) == 3 || image.size(2) == 1),
               "write_png: expected [H, W, 3] or [H, W, 1]");
   const torch::Tensor u8 =
       (image.scalar_type() == torch::kUInt8 ? image : to_uint8(image)).cpu().contiguous();
-  const int h = static_cast<int>(u8.size(0)), w = static_cast<int>(u8.size(1));
-  const int c = static_cast<int>(u8.size(2));
-  std::vector<unsigned char> bytes;
-  const int ok = stbi_write_png_to_func(append_bytes, &bytes, w, h, c, u8.data_ptr<uint8_t>(), w * c);
-  require(ok != 0 && !bytes.empty(), path + ": PNG encoding failed");
-  io::write_atomically(path, [&](const std::string& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    require(out.good(), path + ": cannot open for writing (" + std::strerror(errno) +
-                            "); choose a writable output path");
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    out.flush();
-    require(out.good(), path + ": write failed (disk full?); free space and retry");
-  });
+  io::write_png(path, static_cast<int>(u8.size(1)), static_cast<int>(u8.size(0)),
+                static_cast<int>(u8.size(2)), u8.data_ptr<uint8_t>());
 }
 
 }  // namespace neraf::train

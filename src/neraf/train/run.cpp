@@ -139,12 +139,7 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
             options.run_dir + ": no config.json here, so there is no run to resume; drop --resume "
                               "to start a new run");
     cfg = train_config_from_json(io::read_json(config_path), config_path);
-    if (options.steps) {
-      // Schedules whose decay was tied to the run length follow the new length.
-      for (ScheduleConfig* s : {&cfg.fields, &cfg.proposal_networks, &cfg.audio.schedule})
-        if (s->max_steps == cfg.steps) s->max_steps = *options.steps;
-      cfg.steps = *options.steps;
-    }
+    if (options.steps) set_run_length(cfg, *options.steps);
     if (options.threads) cfg.threads = *options.threads;
     if (fs::is_regular_file(manifest_path, ec)) old_manifest = io::read_json(manifest_path);
     resume_from = latest_checkpoint(options.run_dir);
@@ -211,7 +206,7 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
                     ProgressOptions{"step", 0.2, 10.0, options.progress});
   const auto t0 = std::chrono::steady_clock::now();
   std::deque<double> recent_psnr;
-  double psnr_sum = 0;
+  double psnr_sum = 0, audio_decay = 0;
   int64_t rays = 0;
   for (;;) {
     const StepResult r = trainer->step();
@@ -231,17 +226,25 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     summary.seconds = elapsed;
     summary.rays_per_s = elapsed > 0 ? rays / elapsed : 0;
-    if (r.metrics.count("audio_sl"))  // running mean of the audio log-magnitude MSE
-      summary.last_audio_sl = summary.last_audio_sl == 0
-                                  ? r.metrics.at("audio_sl")
-                                  : 0.98 * summary.last_audio_sl + 0.02 * r.metrics.at("audio_sl");
+    // Running means of the audio terms (log-magnitude MSE, energy-decay L1).
+    auto smooth = [&](const char* key, double& value) {
+      if (!r.metrics.count(key)) return;
+      const double x = r.metrics.at(key);
+      value = value == 0 ? x : 0.98 * value + 0.02 * x;
+    };
+    smooth("audio_sl", summary.last_audio_sl);
+    smooth("audio_decay", audio_decay);
     char status[200];
-    std::snprintf(status, sizeof status, "step %lld  loss %.4f  PSNR %.2f  %.0f rays/s",
-                  static_cast<long long>(r.step), r.loss, summary.last_psnr, summary.rays_per_s);
-    if (summary.last_audio_sl > 0) {
-      const size_t len = std::strlen(status);
-      std::snprintf(status + len, sizeof status - len, "  audio SL %.4f", summary.last_audio_sl);
-    }
+    int len = std::snprintf(status, sizeof status, "step %lld  loss %.4f",
+                            static_cast<long long>(r.step), r.loss);
+    if (cfg.modality != Modality::audio)
+      len += std::snprintf(status + len, sizeof status - len, "  PSNR %.2f  %.0f rays/s",
+                           summary.last_psnr, summary.rays_per_s);
+    if (summary.last_audio_sl > 0)
+      len += std::snprintf(status + len, sizeof status - len, "  audio SL %.4f",
+                           summary.last_audio_sl);
+    if (audio_decay > 0)
+      std::snprintf(status + len, sizeof status - len, "  decay %.4f", audio_decay);
     progress.update(r.step - summary.start_step, status);
 
     const bool done = r.step >= cfg.steps;

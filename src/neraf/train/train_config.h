@@ -50,6 +50,15 @@ struct AudioConfig {
   int64_t nacf_width = 0;           // 0: the acoustic preset's NAcF trunk; else N layers of this
   int64_t nacf_layers = 5;          //    width (only used when nacf_width > 0)
   double fraction = 1.0;            // few-shot: seeded fraction of the train RIRs used (--audio-fraction)
+  // Energy-decay loss (the paper's "++" variant, off in the reference): its weight (0 = off,
+  // --decay-loss) and how many whole RIRs (all frames) per audio step it is computed on.
+  double decay_weight = 0.0;
+  int64_t decay_rirs = 4;
+  // Share of each audio batch drawn from the first early_frames frames (0 = the reference's
+  // uniform slices). The direct sound and early reflections, which carry the binaural level
+  // differences, C50 and EDT, are a few frames of ~100: uniform slices rarely show them.
+  double early_fraction = 0.0;
+  int64_t early_frames = 12;
   std::string vision_run;           // modality audio: the finished vision run whose field is frozen
   // "audio_fields" group: NAcF + ResNet3D (+ the radiance field in joint mode), Adam eps 1e-15,
   // sine warm-up from 1e-8 over warmup_steps then log-linear decay (neraf-reference.md §2.3).
@@ -65,6 +74,10 @@ struct AudioConfig {
     v("nacf_width", nacf_width);
     v("nacf_layers", nacf_layers);
     v("fraction", fraction);
+    v("decay_weight", decay_weight);
+    v("decay_rirs", decay_rirs);
+    v("early_fraction", early_fraction);
+    v("early_frames", early_frames);
     v("vision_run", vision_run);
     v("schedule", schedule);
   }
@@ -102,6 +115,9 @@ struct TrainConfig {
     v("audio", audio);
   }
 };
+
+// Sets c.steps; schedules whose decay was tied to the run length (max_steps == c.steps) follow.
+void set_run_length(TrainConfig& c, int64_t steps);
 
 // The named preset (throws neraf::Error naming --preset for unknown names).
 TrainConfig train_preset(const std::string& name);
