@@ -21,14 +21,17 @@ $NERAF synth --preset demo --layout soundspaces --out "$OUT/scene" --seed 1 --fo
 $NERAF info "$OUT/scene"
 
 step "2/6 train the radiance and acoustic fields jointly (cpu preset)"
-if [ -d "$OUT/run/checkpoints" ]; then
-  $NERAF train --data "$OUT/scene" --out "$OUT/run" --force
-else
-  $NERAF train --data "$OUT/scene" --out "$OUT/run"
-fi
+$NERAF train --data "$OUT/scene" --out "$OUT/run" --force
+# The paper's ablations: the acoustic field alone (2000 steps, as many audio steps as the joint
+# run) without the grid, and with an all-zero grid through the same encoder.
+for grid in none zeros; do
+  $NERAF train --data "$OUT/scene" --modality audio --vision-run "$OUT/run" --grid $grid \
+    --steps 2000 --out "$OUT/run_grid_$grid" --force
+done
 
-step "3/6 evaluate on the held-out RIRs and views (with the nearest and linear baselines)"
-$NERAF eval --run "$OUT/run" --json "$OUT/eval.json"
+step "3/6 evaluate on the held-out RIRs and views (baselines and ablations alongside)"
+$NERAF eval --run "$OUT/run" --json "$OUT/eval.json" \
+  --ablation-runs "$OUT/run_grid_none,$OUT/run_grid_zeros"
 
 step "4/6 render a RIR at a new pose and auralize speech with it"
 $NERAF render rir --run "$OUT/run" --mic "$MIC" --src "$SRC" --yaw 90 --out "$OUT/rir.wav"

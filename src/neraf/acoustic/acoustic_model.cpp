@@ -42,7 +42,7 @@ AcousticModelOptions acoustic_preset(const std::string& name, int64_t n_channels
     o.grid.cells_per_update = 1024;
     o.resnet = resnet3d_cpu_options();
     o.nacf = nacf_cpu_options(n_channels, n_freq, resnet3d_out_features(o.resnet));
-    o.nacf.bf16 = true;
+    o.nacf.bf16 = true;  // training follows --precision (train::audio_model_options)
   } else {
     throw Error("preset: unknown acoustic preset '" + name + "': use cpu or paper");
   }

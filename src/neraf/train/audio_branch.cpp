@@ -21,6 +21,8 @@ acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, in
   o.grid.resolution = a.grid_resolution;
   o.grid.cells_per_update = a.cells_per_update;
   if (a.nacf_width > 0) o.nacf.trunk.assign(static_cast<size_t>(a.nacf_layers), a.nacf_width);
+  // The NAcF trunk follows --precision, as the radiance field's MLPs.
+  o.nacf.bf16 = config.model.precision == nerf::Precision::bf16;
   return o;
 }
 

@@ -60,7 +60,7 @@ TrainConfig train_preset(const std::string& name) {
   c.audio.cells_per_update = 1024;
   c.audio.batch_size = 512;
   c.audio.start_step = 1000;
-  c.audio.schedule = {1e-3, 1e-4, c.steps, 1000, 1e-8, "sine", 1e-15};
+  c.audio.schedule = {2e-3, 1e-4, c.steps, 1000, 1e-8, "sine", 1e-15};
   // The log-magnitude MSE alone predicts the mean log of a diffuse tail, which sits ~2.5 dB
   // below its energy (Rayleigh statistics): the decay curve, and with it T60, EDT and C50, come
   // out biased. The energy-decay loss on 4 whole RIRs per step fits the decay curve itself.
