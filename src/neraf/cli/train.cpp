@@ -78,7 +78,7 @@ void register_train(CLI::App& app) {
       cmd->add_option("--threads", args->threads, "CPU threads (default: all cores)")
           ->check(CLI::PositiveNumber);
   CLI::Option* rays = cmd->add_option("--rays", args->rays,
-                                      "Rays per training batch (default: the preset's, 4096)")
+                                      "Rays per training batch (default: cpu 2048, paper 4096)")
                           ->check(CLI::PositiveNumber);
   CLI::Option* precision =
       cmd->add_option("--precision", args->precision,

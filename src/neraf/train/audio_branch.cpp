@@ -90,6 +90,47 @@ void AudioBranch::set_training(bool training) {
   grid_->train(training);
 }
 
+std::pair<torch::Tensor, torch::Tensor> AudioBranch::sample_slices(at::Generator& gen,
+                                                                   int64_t D) {
+  const int64_t T = rirs_.max_len;
+  const int64_t n = static_cast<int64_t>(train_rirs_.size()) * T;
+  const int64_t B = config_.audio.batch_size;
+  const int64_t B_early = std::llround(config_.audio.early_fraction * static_cast<double>(B));
+  const int64_t B_uniform = B - B_early;
+  // Uniform share: shuffled (RIR, frame) slices, epoch-wise without replacement (the
+  // reference's DataLoader).
+  std::vector<int64_t> picks;
+  picks.reserve(static_cast<size_t>(B_uniform));
+  while (static_cast<int64_t>(picks.size()) < B_uniform) {
+    if (!perm_.defined() || cursor_ >= perm_.size(0)) {
+      perm_ = torch::randperm(n, gen, torch::kInt64);
+      cursor_ = 0;
+    }
+    const int64_t take =
+        std::min(B_uniform - static_cast<int64_t>(picks.size()), perm_.size(0) - cursor_);
+    const int64_t* p = perm_.data_ptr<int64_t>() + cursor_;
+    picks.insert(picks.end(), p, p + take);
+    cursor_ += take;
+  }
+  const torch::Tensor slice = torch::tensor(picks, torch::kInt64);
+  torch::Tensor local = torch::div(slice, T, "floor");  // position in train_rirs_
+  torch::Tensor frame = slice - local * T;
+  // Early share: random train RIRs, frames in [0, early_frames).
+  const int64_t n_rirs = static_cast<int64_t>(train_rirs_.size());
+  if (B_early > 0) {
+    local = torch::cat({local, torch::randint(n_rirs, {B_early}, gen, torch::kInt64)});
+    frame = torch::cat({frame, torch::randint(std::min(T, config_.audio.early_frames),
+                                              {B_early}, gen, torch::kInt64)});
+  }
+  // Whole RIRs: D distinct train RIRs, all frames in order.
+  if (D > 0) {
+    const torch::Tensor whole = torch::randperm(n_rirs, gen, torch::kInt64).slice(0, 0, D);
+    local = torch::cat({local, whole.repeat_interleave(T)});
+    frame = torch::cat({frame, torch::arange(T, torch::kInt64).repeat({D})});
+  }
+  return {torch::tensor(train_rirs_, torch::kInt64).index_select(0, local), frame};
+}
+
 LossDict AudioBranch::losses(StepContext& ctx) {
   const bool audio_step = ctx.step > config_.audio.start_step;
   const bool sampled = model_->options().grid_mode == acoustic::GridMode::kSampled;
@@ -104,49 +145,12 @@ LossDict AudioBranch::losses(StepContext& ctx) {
   }
   if (!audio_step) return {};
 
-  const int64_t T = rirs_.max_len;
-  const int64_t n = static_cast<int64_t>(train_rirs_.size()) * T;
-  const int64_t B = config_.audio.batch_size;
-  // Early slices: a share of the batch drawn from the first early_frames frames of random RIRs.
-  const int64_t B_early =
-      std::llround(config_.audio.early_fraction * static_cast<double>(B));
-  const int64_t B_uniform = B - B_early;
-  // Shuffled (RIR, frame) slices, epoch-wise without replacement (the reference's DataLoader).
-  std::vector<int64_t> picks;
-  picks.reserve(static_cast<size_t>(B));
-  while (static_cast<int64_t>(picks.size()) < B_uniform) {
-    if (!perm_.defined() || cursor_ >= perm_.size(0)) {
-      perm_ = torch::randperm(n, ctx.gen, torch::kInt64);
-      cursor_ = 0;
-    }
-    const int64_t take =
-        std::min(B_uniform - static_cast<int64_t>(picks.size()), perm_.size(0) - cursor_);
-    const int64_t* p = perm_.data_ptr<int64_t>() + cursor_;
-    picks.insert(picks.end(), p, p + take);
-    cursor_ += take;
-  }
-  torch::Tensor rir_index = torch::tensor(train_rirs_, torch::kInt64);
-  torch::Tensor slice = torch::tensor(picks, torch::kInt64);
-  torch::Tensor local = torch::div(slice, T, "floor");
-  torch::Tensor frame = slice - local * T;  // [B_uniform]
-  if (B_early > 0) {
-    const int64_t early = std::min(T, config_.audio.early_frames);
-    local = torch::cat({local, torch::randint(rir_index.size(0), {B_early}, ctx.gen, torch::kInt64)});
-    frame = torch::cat({frame, torch::randint(early, {B_early}, ctx.gen, torch::kInt64)});
-  }
-  torch::Tensor rir = rir_index.index_select(0, local);  // [B]
-  // Energy-decay loss: D whole RIRs (all T frames, in order) appended to the same batch, so the
-  // scene encoder runs once per step.
+  const int64_t B = config_.audio.batch_size, T = rirs_.max_len;
   const double decay_weight = config_.audio.decay_weight;
   const int64_t D = decay_weight > 0 ? std::min<int64_t>(config_.audio.decay_rirs,
-                                                         rir_index.size(0))
+                                                         static_cast<int64_t>(train_rirs_.size()))
                                      : 0;
-  if (D > 0) {
-    const torch::Tensor whole =
-        rir_index.index_select(0, torch::randperm(rir_index.size(0), ctx.gen).slice(0, 0, D));
-    rir = torch::cat({rir, whole.repeat_interleave(T)});
-    frame = torch::cat({frame, torch::arange(T, torch::kInt64).repeat({D})});
-  }
+  const auto [rir, frame] = sample_slices(ctx.gen, D);
   if (!batch_.defined() || batch_.size(0) != rir.size(0))
     batch_ = torch::empty({rir.size(0), rirs_.channels, rirs_.n_freq}, torch::kFloat32);
   rirs_.gather_into(rir, frame, batch_);

@@ -65,6 +65,11 @@ class AudioBranch : public Branch {
   acoustic::FieldQueryFn field_query();
 
  private:
+  // The step's (RIR index, frame) pairs, each [B + D·T] int64: batch_size slices (the uniform
+  // share from the epoch permutation, then the early share), then D whole RIRs for the
+  // energy-decay loss (D = 0 when it is off).
+  std::pair<torch::Tensor, torch::Tensor> sample_slices(at::Generator& gen, int64_t D);
+
   TrainConfig config_;
   const data::RirSet& rirs_;
   nerf::NerfactoModel field_;
@@ -75,7 +80,7 @@ class AudioBranch : public Branch {
   std::vector<int64_t> train_rirs_;  // indices into rirs_.rirs
   torch::Tensor perm_;               // [n_train·max_len] int64: this epoch's slice order
   int64_t cursor_ = 0;               // next position in perm_
-  torch::Tensor batch_;              // [B, C, F] float32 gather buffer
+  torch::Tensor batch_;              // [B + D·T, C, F] float32 gather buffer
 };
 
 }  // namespace neraf::train

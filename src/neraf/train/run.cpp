@@ -91,6 +91,14 @@ nlohmann::json make_data_manifest(const data::ImageSet& images, const std::strin
     eval_intr.push_back(intrinsics_json(images.eval.intrinsics[static_cast<size_t>(i)]));
   }
   const data::Intrinsics& k0 = images.train.intrinsics.at(0);
+  // Image paths relative to the dataset folder, so the same data read from another working
+  // directory (or by absolute path) matches.
+  const fs::path root = fs::path(images.source).parent_path();
+  auto relative = [&root](const std::vector<std::string>& files) {
+    std::vector<std::string> out;
+    for (const auto& f : files) out.push_back(fs::path(f).lexically_relative(root).string());
+    return out;
+  };
   return {{"format", kManifestFormat},
           {"data", abs},
           {"source", images.source},
@@ -99,8 +107,8 @@ nlohmann::json make_data_manifest(const data::ImageSet& images, const std::strin
           {"num_eval", images.eval.size()},
           {"height", k0.height},
           {"width", k0.width},
-          {"train_files", images.train.files},
-          {"eval_files", images.eval.files},
+          {"train_files", relative(images.train.files)},
+          {"eval_files", relative(images.eval.files)},
           {"world_transform", matrix_json(images.world_transform)},
           {"world_scale", images.world_scale},
           {"default_intrinsics", intrinsics_json(k0)},
