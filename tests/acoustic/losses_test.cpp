@@ -60,42 +60,40 @@ TEST(AudioLoss, WeightsAreConfigurableAndGradientFlows) {
   EXPECT_LT(pred.grad().max().item<float>(), 0.0f);  // raising pred towards gt lowers the loss
 }
 
+// One RIR, one channel, F = 2, T = 3, as log-magnitudes log(M + 1e-3) of these magnitudes M.
+const double kDecayPred[2][3] = {{1.0, 0.5, 0.25}, {0.0, 0.5, 0.0}};
+const double kDecayGt[2][3] = {{2.0, 0.5, 0.1}, {0.0, 0.0, 0.1}};
+torch::Tensor decay_log(const double m[2][3]) {
+  auto t = torch::empty({1, 1, 2, 3}, torch::kFloat64);
+  for (int f = 0; f < 2; ++f)
+    for (int k = 0; k < 3; ++k) t[0][0][f][k] = std::log(m[f][k] + 1e-3);
+  return t;
+}
+
 TEST(EnergyDecayLoss, HandComputed) {
   // One RIR, one channel, F = 2, T = 3. Magnitudes M = exp(L) − 1e-3.
-  const double mp[2][3] = {{1.0, 0.5, 0.25}, {0.0, 0.5, 0.0}};
-  const double mg[2][3] = {{2.0, 0.5, 0.1}, {0.0, 0.0, 0.1}};
-  auto to_log = [](const double m[2][3]) {
-    auto t = torch::empty({1, 1, 2, 3}, torch::kFloat64);
-    for (int f = 0; f < 2; ++f)
-      for (int k = 0; k < 3; ++k) t[0][0][f][k] = std::log(m[f][k] + 1e-3);
-    return t;
-  };
   // E_p = (1, 0.5, 0.0625) → D_p = (1.5625, 0.5625, 0.0625); E_g = (4, 0.25, 0.02) →
   // D_g = (4.27, 0.27, 0.02).
   const double dp[3] = {1.5625, 0.5625, 0.0625}, dg[3] = {4.27, 0.27, 0.02};
   double want = 0;
   for (int k = 0; k < 3; ++k) want += std::abs(std::log10(dp[k]) - std::log10(dg[k])) / 3.0;
-  EXPECT_NEAR(energy_decay_loss(to_log(mp), to_log(mg)).item<double>(), want, 1e-5);
+  EXPECT_NEAR(energy_decay_loss(decay_log(kDecayPred), decay_log(kDecayGt)).item<double>(), want,
+              1e-5);
   EXPECT_NEAR(want, 0.416739, 1e-5);
-  EXPECT_NEAR(energy_decay_loss(to_log(mg), to_log(mg)).item<double>(), 0.0, 1e-7);
+  EXPECT_NEAR(energy_decay_loss(decay_log(kDecayGt), decay_log(kDecayGt)).item<double>(), 0.0,
+              1e-7);
 }
 
 TEST(EnergyDecayLoss, FloorIgnoresTheCurveFarBelowTheTotalEnergy) {
   // GT D = (4.27, 0.27, 0.02): a 10 dB floor sits at log10(4.27) − 1 = log10(0.427), so only
   // frame 0 counts (both curves are clamped at the floor for frames 1 and 2).
-  const double mp[2][3] = {{1.0, 0.5, 0.25}, {0.0, 0.5, 0.0}};
-  const double mg[2][3] = {{2.0, 0.5, 0.1}, {0.0, 0.0, 0.1}};
-  auto to_log = [](const double m[2][3]) {
-    auto t = torch::empty({1, 1, 2, 3}, torch::kFloat64);
-    for (int f = 0; f < 2; ++f)
-      for (int k = 0; k < 3; ++k) t[0][0][f][k] = std::log(m[f][k] + 1e-3);
-    return t;
-  };
   // pred D = (1.5625, 0.5625, 0.0625) → clamped (1.5625, 0.5625, 0.427).
   const double want = (std::abs(std::log10(1.5625) - std::log10(4.27)) +
                        std::abs(std::log10(0.5625) - std::log10(0.427))) /
                       3.0;
-  EXPECT_NEAR(energy_decay_loss(to_log(mp), to_log(mg), 1e-12, 10.0).item<double>(), want, 1e-5);
+  EXPECT_NEAR(
+      energy_decay_loss(decay_log(kDecayPred), decay_log(kDecayGt), 1e-12, 10.0).item<double>(),
+      want, 1e-5);
 }
 
 TEST(EnergyDecayLoss, SilentTailStaysFiniteAndDifferentiable) {

@@ -6,21 +6,7 @@
 set -u
 NERAF=$1
 ASSETS=$2
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-failures=0
-
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-expect_exit() {  # expect_exit CODE CMD...: stdout/stderr in $TMP/out, $TMP/err
-  local want=$1; shift
-  "$@" >"$TMP/out" 2>"$TMP/err"
-  local got=$?
-  [ "$got" -eq "$want" ] || fail "'$*' exited $got, expected $want; stderr: $(tail -c 400 "$TMP/err")"
-}
-expect_in() {  # expect_in FILE PATTERN
-  grep -q -- "$2" "$1" || fail "expected '$2' in $(basename "$1"): $(tail -c 300 "$1")"
-}
-expect_file() { [ -s "$1" ] || fail "expected a non-empty $1"; }
+source "$(dirname "$0")/lib.sh"
 
 S=$TMP/scene R=$TMP/run
 MIC=2.0,1.5,2.5 SRC=1.1,1.2,0.9
@@ -55,7 +41,7 @@ expect_exit 0 "$NERAF" render rir --run "$R" --mic "$MIC" --src "$SRC" --yaw 90 
 expect_exit 0 "$NERAF" metrics --rir "$TMP/rir.wav" --json
 expect_in "$TMP/out" '"channels"'
 expect_exit 2 "$NERAF" render rir --run "$R" --mic "$MIC" --src "$SRC" --yaw north --out "$TMP/x.wav"
-expect_exit 1 "$NERAF" render rir --run "$R" --mic 2.0,1.5 --src "$SRC" --out "$TMP/x.wav"
+expect_exit 2 "$NERAF" render rir --run "$R" --mic 2.0,1.5 --src "$SRC" --out "$TMP/x.wav"
 expect_in "$TMP/err" "--mic"
 expect_exit 0 "$NERAF" render rir --run "$R" --mic 40,1.5,2.5 --src "$SRC" --out "$TMP/far.wav"
 expect_in "$TMP/err" "outside"
@@ -77,8 +63,4 @@ expect_exit 0 "$NERAF" train --data "$S" --modality vision --out "$TMP/vis" --st
 expect_exit 1 "$NERAF" render rir --run "$TMP/vis" --mic "$MIC" --src "$SRC" --out "$TMP/x.wav"
 expect_in "$TMP/err" "vision"
 
-if [ "$failures" -gt 0 ]; then
-  echo "$failures CLI pipeline check(s) failed"
-  exit 1
-fi
-echo "all CLI pipeline checks passed"
+finish "CLI pipeline"

@@ -4,21 +4,7 @@
 set -u
 NERAF=$1
 ASSETS=$2
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-failures=0
-
-fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
-# expect_exit CODE CMD...: runs CMD, captures stdout/stderr in $TMP/out, $TMP/err
-expect_exit() {
-  local want=$1; shift
-  "$@" >"$TMP/out" 2>"$TMP/err"
-  local got=$?
-  [ "$got" -eq "$want" ] || fail "'$*' exited $got, expected $want; stderr: $(head -c 300 "$TMP/err")"
-}
-expect_in() {  # expect_in FILE PATTERN
-  grep -q -- "$2" "$1" || fail "expected '$2' in $(basename "$1"): $(head -c 300 "$1")"
-}
+source "$(dirname "$0")/lib.sh"
 
 # --- the program and its help -------------------------------------------------------------
 expect_exit 0 "$NERAF" --help
@@ -73,8 +59,4 @@ ls "$TMP" | grep -q 'tmp-' && fail "auralize left a temporary file"
 expect_exit 1 "$NERAF" auralize --rir "$TMP/missing.wav" --in "$ASSETS/real/castanets_dry.wav" --out "$TMP/x.wav"
 [ -f "$TMP/x.wav" ] && fail "failed auralize left an output"
 
-if [ "$failures" -gt 0 ]; then
-  echo "$failures CLI check(s) failed"
-  exit 1
-fi
-echo "all CLI checks passed"
+finish "CLI"

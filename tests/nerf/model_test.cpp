@@ -1,11 +1,10 @@
-#include "neraf/nerf/nerfacto_model.h"
-
 #include <ATen/CPUGeneratorImpl.h>
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
 #include <cstdio>
 
+#include "neraf/nerf/nerfacto_model.h"
 #include "neraf/nerf/samplers.h"
 
 using namespace neraf::nerf;
@@ -59,8 +58,8 @@ TEST(NerfactoField, MlpsAreBiasFreeWithNerfactoSizes) {
 
 TEST(NerfactoField, QueryInterface) {
   NerfactoField f(tiny_config().field, 4, Precision::fp32, 3);
-  const auto u = torch::tensor({{0.5f, 0.5f, 0.5f}, {0.1f, 0.9f, 0.3f}, {0.0f, 0.5f, 0.5f},
-                                {1.2f, 0.5f, 0.5f}});
+  const auto u = torch::tensor(
+      {{0.5f, 0.5f, 0.5f}, {0.1f, 0.9f, 0.3f}, {0.0f, 0.5f, 0.5f}, {1.2f, 0.5f, 0.5f}});
   auto dirs = torch::tensor({{0.f, 0.f, 1.f}, {1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}, {0.f, 0.f, -1.f}});
   const FieldQuery q = f->query(u, dirs, torch::tensor({-1}, torch::kInt64));
   ASSERT_EQ(q.density.sizes(), (std::vector<int64_t>{4}));

@@ -67,6 +67,7 @@ TEST(Run, TrainResumeRefuseAndLoad) {
   write_dataset(data, fixtures::make_image_set(3, 12));  // SSIM needs >= 11 px
   TrainConfig cfg = fixtures::tiny_train_config();
   cfg.steps = 4;
+  cfg.fields.max_steps = cfg.proposal_networks.max_steps = 4;  // decay over the run (cpu preset)
   cfg.save_every = 2;
   TrainRunOptions o;
   o.data_dir = data.string();
@@ -90,6 +91,9 @@ TEST(Run, TrainResumeRefuseAndLoad) {
   EXPECT_EQ(s2.start_step, 4);
   EXPECT_EQ(s2.end_step, 6);
   EXPECT_EQ(neraf::io::read_json((run / "config.json").string())["steps"], 6);
+  // The schedules tied to the run length followed it, and the run still loads its checkpoint.
+  EXPECT_EQ(neraf::io::read_json((run / "config.json").string())["fields"]["max_steps"], 6);
+  EXPECT_EQ(load_run(run.string()).step, 6);
 
   // Interrupt flag: stops after one step with a checkpoint.
   std::atomic<bool> stop{true};

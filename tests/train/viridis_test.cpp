@@ -1,7 +1,7 @@
-#include "neraf/train/image_output.h"
-
 #include <gtest/gtest.h>
 #include <torch/torch.h>
+
+#include "neraf/train/image_output.h"
 
 namespace neraf::train {
 namespace {

@@ -60,9 +60,9 @@ ResBlock3dImpl::ResBlock3dImpl(ResBlock kind, int64_t in_channels, int64_t plane
     bn2 = register_module("bn2", batch_norm(planes));
   }
   if (stride != 1 || in_channels != out_channels) {
-    downsample =
-        register_module("downsample", nn::Sequential(conv(in_channels, out_channels, 1, stride, 0),
-                                                     batch_norm(out_channels)));
+    downsample = register_module(
+        "downsample",
+        nn::Sequential(conv(in_channels, out_channels, 1, stride, 0), batch_norm(out_channels)));
   }
 }
 

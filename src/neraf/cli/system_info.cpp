@@ -1,8 +1,7 @@
 #include "neraf/cli/system_info.h"
 
-#include <torch/torch.h>
-
 #include <sched.h>
+#include <torch/torch.h>
 
 #include <algorithm>
 #include <cstdlib>

@@ -46,7 +46,8 @@ struct TrainArgs {
 void register_train(CLI::App& app) {
   auto args = std::make_shared<TrainArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "train", "Train a scene's radiance and acoustic fields (posed images + RIRs), jointly by default");
+      "train",
+      "Train a scene's radiance and acoustic fields (posed images + RIRs), jointly by default");
   cmd->footer(
       "Writes RUN/config.json (the resolved config), RUN/data.json (dataset manifest) and\n"
       "RUN/checkpoints/step-XXXXXXXXX.pt. Ctrl-C saves a checkpoint and exits; continue with\n"
@@ -150,12 +151,14 @@ void register_train(CLI::App& app) {
     if (decay_loss->count()) cfg.audio.decay_weight = args->decay_loss;
     cfg.audio.fraction = args->audio_fraction;
     if (vision_run->count())
-      cfg.audio.vision_run = std::filesystem::absolute(args->vision_run).lexically_normal().string();
+      cfg.audio.vision_run =
+          std::filesystem::absolute(args->vision_run).lexically_normal().string();
     require(cfg.modality == train::Modality::audio || vision_run->count() == 0,
             "--vision-run: only used with --modality audio");
     if (threads->count()) cfg.threads = args->threads;
     if (rays->count()) cfg.rays_per_batch = args->rays;
-    if (precision->count()) cfg.model.precision = nerf::parse_precision(args->precision, "--precision");
+    if (precision->count())
+      cfg.model.precision = nerf::parse_precision(args->precision, "--precision");
     if (cfg.model.precision == nerf::Precision::bf16 && !nerf::cpu_supports_bf16())
       warn("--precision bf16: this CPU has no native bf16 instructions; expect slow training");
 

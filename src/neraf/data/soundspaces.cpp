@@ -283,11 +283,11 @@ int64_t soundspaces_features_from_npy(const std::string& npy, int64_t max_len, f
               ": expected magnitudes of shape [2, 257, T], got a different shape; re-create "
               "the file or delete binaural_magnitudes_sr22050/ to compute features from the wavs");
   const int64_t n_frames = a.shape[2];
-  require(std::all_of(a.data.begin(), a.data.end(),
-                      [](float v) { return std::isfinite(v) && v >= 0; }),
-          npy +
-                ": contains negative or non-finite magnitudes; re-create the file or delete "
-                "binaural_magnitudes_sr22050/ to compute features from the wavs");
+  require(
+      std::all_of(a.data.begin(), a.data.end(), [](float v) { return std::isfinite(v) && v >= 0; }),
+      npy +
+          ": contains negative or non-finite magnitudes; re-create the file or delete "
+          "binaural_magnitudes_sr22050/ to compute features from the wavs");
   write_padded_log({a.data.data(), a.data.data() + n_freq * n_frames}, n_freq, n_frames, max_len,
                    out);
   return n_frames;

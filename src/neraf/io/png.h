@@ -11,7 +11,6 @@ namespace neraf::io {
 std::vector<uint8_t> encode_png(int width, int height, int channels, const uint8_t* pixels);
 
 // encode_png, then written atomically; neraf::Error naming `path` when that fails.
-void write_png(const std::string& path, int width, int height, int channels,
-               const uint8_t* pixels);
+void write_png(const std::string& path, int width, int height, int channels, const uint8_t* pixels);
 
 }  // namespace neraf::io

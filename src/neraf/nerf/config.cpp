@@ -1,7 +1,6 @@
 #include "neraf/nerf/config.h"
 
 #include <cmath>
-
 #include <fstream>
 #include <sstream>
 

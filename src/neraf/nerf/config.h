@@ -3,7 +3,6 @@
 // `paper` preset = nerfstudio's `nerfacto` method with NeRAF's overrides, radiance-field-and-cpu.md
 // §2 and neraf-reference.md §2.6). `model_preset("cpu")` is the smaller, faster default.
 #include <nlohmann/json.hpp>
-
 #include <string>
 #include <vector>
 
@@ -44,8 +43,8 @@ struct FieldConfig {  // nerfstudio NerfactoField
   // unlike any of them: on exposure-stable captures the colour of held-out views shifts. Small
   // initial codes start as one cloud whose mean stays inside it (the cpu preset's 0.01).
   double appearance_init_std = 1.0;
-  int sh_degree = 4;                    // 16 direction features
-  double average_init_density = 0.01;   // NeRAF / nerfacto preset (model default would be 1.0)
+  int sh_degree = 4;                   // 16 direction features
+  double average_init_density = 0.01;  // NeRAF / nerfacto preset (model default would be 1.0)
   bool use_average_appearance_embedding = true;  // eval: mean embedding (else zeros)
 
   template <class V>

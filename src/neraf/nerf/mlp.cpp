@@ -23,8 +23,8 @@ MlpImpl::MlpImpl(int in_dim, int hidden_dim, int out_dim, int num_layers, Precis
     const int64_t i = l == 0 ? in_dim : hidden_dim;
     const int64_t o = l == num_layers - 1 ? out_dim : hidden_dim;
     // Layer seeds derived from the module seed so that layers differ but stay reproducible.
-    weights_.push_back(register_parameter("w" + std::to_string(l),
-                                          xavier_uniform(o, i, seed * 1000003ULL + l)));
+    weights_.push_back(
+        register_parameter("w" + std::to_string(l), xavier_uniform(o, i, seed * 1000003ULL + l)));
   }
 }
 
@@ -55,7 +55,8 @@ void relu_backward_inplace(torch::Tensor& g, const torch::Tensor& a) {
     uint16_t* pg = reinterpret_cast<uint16_t*>(g.data_ptr<at::BFloat16>());
     const uint16_t* pa = reinterpret_cast<const uint16_t*>(a.data_ptr<at::BFloat16>());
     at::parallel_for(0, n, 1 << 16, [&](int64_t b, int64_t e) {
-      for (int64_t i = b; i < e; ++i) pg[i] = (pa[i] == 0 || (pa[i] & 0x8000u)) ? uint16_t{0} : pg[i];
+      for (int64_t i = b; i < e; ++i)
+        pg[i] = (pa[i] == 0 || (pa[i] & 0x8000u)) ? uint16_t{0} : pg[i];
     });
   } else {
     float* pg = g.data_ptr<float>();

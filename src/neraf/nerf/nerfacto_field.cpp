@@ -12,13 +12,13 @@ NerfactoFieldImpl::NerfactoFieldImpl(const FieldConfig& config, int64_t num_trai
     : config_(config), num_train_images_(num_train_images) {
   TORCH_CHECK(num_train_images >= 1, "NerfactoField: need at least one training image");
   grid = register_module("grid", HashGrid(config.grid, seed + 1));
-  mlp_base = register_module(
-      "mlp_base", Mlp(grid->output_dim(), config.hidden_dim, 1 + config.geo_feat_dim,
-                      config.num_layers, precision, seed + 2));
+  mlp_base = register_module("mlp_base",
+                             Mlp(grid->output_dim(), config.hidden_dim, 1 + config.geo_feat_dim,
+                                 config.num_layers, precision, seed + 2));
   const int sh_dim = config.sh_degree * config.sh_degree;
   mlp_head = register_module(
-      "mlp_head", Mlp(sh_dim + config.geo_feat_dim + config.appearance_dim,
-                      config.hidden_dim_color, 3, config.num_layers_color, precision, seed + 3));
+      "mlp_head", Mlp(sh_dim + config.geo_feat_dim + config.appearance_dim, config.hidden_dim_color,
+                      3, config.num_layers_color, precision, seed + 3));
   // N(0, appearance_init_std²); torch.nn.Embedding's initialisation is N(0, 1).
   auto gen = at::make_generator<at::CPUGeneratorImpl>(seed + 4);
   embedding_appearance = register_parameter(
@@ -34,8 +34,8 @@ void NerfactoFieldImpl::set_precision(Precision p) {
 
 std::pair<torch::Tensor, torch::Tensor> NerfactoFieldImpl::density_and_geo(const GridInput& in) {
   const torch::Tensor h = mlp_base->forward(grid->forward(in.u));  // [N, 1 + geo]
-  const torch::Tensor raw = h.select(1, 0);                         // [N]
-  const torch::Tensor geo = h.slice(1, 1);                          // [N, geo]
+  const torch::Tensor raw = h.select(1, 0);                        // [N]
+  const torch::Tensor geo = h.slice(1, 1);                         // [N, geo]
   const torch::Tensor density =
       trunc_exp(raw) * config_.average_init_density * in.selector.to(torch::kFloat32);
   return {density, geo};
@@ -43,12 +43,11 @@ std::pair<torch::Tensor, torch::Tensor> NerfactoFieldImpl::density_and_geo(const
 
 torch::Tensor NerfactoFieldImpl::appearance_embedding(const torch::Tensor& ids) {
   const auto ids64 = ids.to(torch::kInt64);
-  const torch::Tensor rows =
-      embedding_appearance.index_select(0, ids64.clamp_min(0));  // [M, A]
-  const torch::Tensor fallback = config_.use_average_appearance_embedding
-                                     ? embedding_appearance.mean(0, /*keepdim=*/true)
-                                     : torch::zeros({1, config_.appearance_dim},
-                                                    embedding_appearance.options());
+  const torch::Tensor rows = embedding_appearance.index_select(0, ids64.clamp_min(0));  // [M, A]
+  const torch::Tensor fallback =
+      config_.use_average_appearance_embedding
+          ? embedding_appearance.mean(0, /*keepdim=*/true)
+          : torch::zeros({1, config_.appearance_dim}, embedding_appearance.options());
   return torch::where((ids64 >= 0).unsqueeze(1), rows, fallback);
 }
 
@@ -89,13 +88,12 @@ FieldQuery NerfactoFieldImpl::query(const torch::Tensor& u, const torch::Tensor&
   return {density, color(sh, geo, app)};
 }
 
-ProposalFieldImpl::ProposalFieldImpl(const ProposalNetConfig& config,
-                                     double average_init_density, Precision precision,
-                                     uint64_t seed)
+ProposalFieldImpl::ProposalFieldImpl(const ProposalNetConfig& config, double average_init_density,
+                                     Precision precision, uint64_t seed)
     : average_init_density_(average_init_density) {
   grid = register_module("grid", HashGrid(config.grid, seed + 1));
-  mlp = register_module("mlp", Mlp(grid->output_dim(), config.hidden_dim, 1, config.num_layers,
-                                   precision, seed + 2));
+  mlp = register_module(
+      "mlp", Mlp(grid->output_dim(), config.hidden_dim, 1, config.num_layers, precision, seed + 2));
 }
 
 torch::Tensor ProposalFieldImpl::forward(const torch::Tensor& positions) {

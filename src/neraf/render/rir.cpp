@@ -49,8 +49,8 @@ io::AudioBuffer rir_from_log_stft(const torch::Tensor& log_stft, const dsp::Stft
   TORCH_CHECK(log_stft.size(1) == stft.n_freq(), "rir_from_log_stft: F does not match n_fft");
   io::AudioBuffer out;
   out.sample_rate = sample_rate;
-  out.channels = train::griffin_lim_channels(train::log_stft_to_magnitude(log_stft.cpu()), stft,
-                                             options.seed);
+  out.channels =
+      train::griffin_lim_channels(train::log_stft_to_magnitude(log_stft.cpu()), stft, options.seed);
   return out;
 }
 

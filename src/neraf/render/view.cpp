@@ -50,16 +50,16 @@ torch::Tensor matrix_from_json(const nlohmann::json& j, const std::string& where
   torch::Tensor m = torch::tensor(v, torch::kFloat64).view({static_cast<int64_t>(j.size()), 4});
   if (j.size() == 4) {
     const auto last = m[3];
-    require(torch::allclose(last, torch::tensor({0.0, 0.0, 0.0, 1.0}, torch::kFloat64), 1e-6,
-                            1e-6),
+    require(torch::allclose(last, torch::tensor({0.0, 0.0, 0.0, 1.0}, torch::kFloat64), 1e-6, 1e-6),
             where + ": the last row of a 4×4 pose must be 0 0 0 1");
     m = m.slice(0, 0, 3);
   }
   const torch::Tensor R = m.slice(1, 0, 3);
   const double ortho =
       (torch::matmul(R, R.t()) - torch::eye(3, torch::kFloat64)).abs().max().item<double>();
-  require(ortho < 1e-3, where + ": the rotation part is not orthonormal (a camera-to-world "
-                                "matrix is [R | t] with R a rotation)");
+  require(ortho < 1e-3, where +
+                            ": the rotation part is not orthonormal (a camera-to-world "
+                            "matrix is [R | t] with R a rotation)");
   return m;
 }
 
@@ -91,8 +91,10 @@ Camera read_camera_file(const std::string& path, const nlohmann::json& manifest)
     nlohmann::json k = j["intrinsics"];
     require(k.is_object(), path + ": \"intrinsics\" must be an object");
     // Accept transforms.json spellings.
-    for (auto [from, to] : {std::pair<const char*, const char*>{"fl_x", "fx"}, {"fl_y", "fy"},
-                            {"w", "width"}, {"h", "height"}})
+    for (auto [from, to] : {std::pair<const char*, const char*>{"fl_x", "fx"},
+                            {"fl_y", "fy"},
+                            {"w", "width"},
+                            {"h", "height"}})
       if (k.contains(from) && !k.contains(to)) k[to] = k[from];
     // Missing fields keep the default camera's values (the principal point is not rescaled when
     // only the size changes: give cx, cy with a new width/height).

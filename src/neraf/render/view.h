@@ -1,8 +1,8 @@
 #pragma once
 // Rendering views of a trained radiance field to PNG files.
-#include <nlohmann/json.hpp>
 #include <torch/types.h>
 
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "neraf/data/image_set.h"

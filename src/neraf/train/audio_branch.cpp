@@ -90,8 +90,7 @@ void AudioBranch::set_training(bool training) {
   grid_->train(training);
 }
 
-std::pair<torch::Tensor, torch::Tensor> AudioBranch::sample_slices(at::Generator& gen,
-                                                                   int64_t D) {
+std::pair<torch::Tensor, torch::Tensor> AudioBranch::sample_slices(at::Generator& gen, int64_t D) {
   const int64_t T = rirs_.max_len;
   const int64_t n = static_cast<int64_t>(train_rirs_.size()) * T;
   const int64_t B = config_.audio.batch_size;
@@ -119,8 +118,8 @@ std::pair<torch::Tensor, torch::Tensor> AudioBranch::sample_slices(at::Generator
   const int64_t n_rirs = static_cast<int64_t>(train_rirs_.size());
   if (B_early > 0) {
     local = torch::cat({local, torch::randint(n_rirs, {B_early}, gen, torch::kInt64)});
-    frame = torch::cat({frame, torch::randint(std::min(T, config_.audio.early_frames),
-                                              {B_early}, gen, torch::kInt64)});
+    frame = torch::cat({frame, torch::randint(std::min(T, config_.audio.early_frames), {B_early},
+                                              gen, torch::kInt64)});
   }
   // Whole RIRs: D distinct train RIRs, all frames in order.
   if (D > 0) {

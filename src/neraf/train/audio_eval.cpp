@@ -245,10 +245,9 @@ void write_stft_comparison_png(const std::string& path, const torch::Tensor& pre
   const int64_t F = p.size(0), gap = 2, scale = 3;
   auto colour = [&](const torch::Tensor& m) { return viridis((m - lo) / std::max(hi - lo, 1e-9)); };
   // [F, T + gap + Tg, 3] white gap between the two, then each pixel drawn as scale × scale.
-  torch::Tensor img =
-      torch::cat({colour(p), torch::ones({F, gap, 3}), colour(g)}, 1)
-          .repeat_interleave(scale, 0)
-          .repeat_interleave(scale, 1);
+  torch::Tensor img = torch::cat({colour(p), torch::ones({F, gap, 3}), colour(g)}, 1)
+                          .repeat_interleave(scale, 0)
+                          .repeat_interleave(scale, 1);
   write_png(path, img);
 }
 

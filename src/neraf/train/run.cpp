@@ -24,9 +24,9 @@ constexpr const char* kManifestFormat = "neraf-run-data-1";
 }  // namespace
 
 nlohmann::json intrinsics_json(const data::Intrinsics& k) {
-  return {{"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy}, {"width", k.width},
-          {"height", k.height}, {"k1", k.k1}, {"k2", k.k2}, {"k3", k.k3}, {"p1", k.p1},
-          {"p2", k.p2}};
+  return {{"fx", k.fx},       {"fy", k.fy},         {"cx", k.cx}, {"cy", k.cy},
+          {"width", k.width}, {"height", k.height}, {"k1", k.k1}, {"k2", k.k2},
+          {"k3", k.k3},       {"p1", k.p1},         {"p2", k.p2}};
 }
 
 data::Intrinsics intrinsics_from_json(const nlohmann::json& j, const std::string& where) {
@@ -144,8 +144,9 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
   if (options.resume) {
     std::error_code ec;
     require(fs::is_regular_file(config_path, ec),
-            options.run_dir + ": no config.json here, so there is no run to resume; drop --resume "
-                              "to start a new run");
+            options.run_dir +
+                ": no config.json here, so there is no run to resume; drop --resume "
+                "to start a new run");
     cfg = train_config_from_json(io::read_json(config_path), config_path);
     if (options.steps) set_run_length(cfg, *options.steps);
     if (options.threads) cfg.threads = *options.threads;
@@ -186,15 +187,16 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
       check_audio_manifest(old_manifest["audio"], *rirs, data_dir);
     manifest["audio"] = make_audio_manifest(*rirs);
   }
-  io::write_json_atomically(config_path, to_json(cfg));
-  io::write_json_atomically(manifest_path, manifest);
-
   std::unique_ptr<Trainer> trainer = make_trainer(cfg, &images, options.device, rirs.get());
   if (resume_from) {
     trainer->load_checkpoint(*resume_from);
     info("resuming " + options.run_dir + " from step " +
          std::to_string(trainer->completed_steps()) + " (" + *resume_from + ")");
   }
+  // Written only once the checkpoint is known to match, so a refused resume leaves the run as
+  // it was.
+  io::write_json_atomically(config_path, to_json(cfg));
+  io::write_json_atomically(manifest_path, manifest);
 
   TrainRunSummary summary;
   summary.start_step = trainer->completed_steps();
@@ -281,8 +283,9 @@ LoadedRun load_run(const std::string& run_dir, torch::Device device,
   const std::string manifest_path = run_file(run_dir, "data.json");
   require(fs::is_directory(run_dir, ec), run_dir + ": no such run folder; check --run");
   require(fs::is_regular_file(config_path, ec),
-          run_dir + ": not a training run (no config.json); point --run at a neraf train --out "
-                    "folder");
+          run_dir +
+              ": not a training run (no config.json); point --run at a neraf train --out "
+              "folder");
   LoadedRun run;
   run.run_dir = run_dir;
   run.config = train_config_from_json(io::read_json(config_path), config_path);
@@ -291,8 +294,8 @@ LoadedRun load_run(const std::string& run_dir, torch::Device device,
           manifest_path + ": not a neraf run data manifest; re-run neraf train");
   if (checkpoint.empty()) {
     const auto latest = latest_checkpoint(run_dir);
-    require(latest.has_value(), run_dir + ": no checkpoint yet; train first (neraf train --out " +
-                                    run_dir + ")");
+    require(latest.has_value(),
+            run_dir + ": no checkpoint yet; train first (neraf train --out " + run_dir + ")");
     run.checkpoint = *latest;
   } else {
     run.checkpoint = checkpoint;

@@ -121,8 +121,9 @@ void validate(const TrainConfig& c, const std::string& where) {
   require(a.cells_per_update >= 1, where + ".audio.cells_per_update: must be at least 1");
   require(a.nacf_width >= 0 && a.nacf_layers >= 1,
           where + ".audio.nacf_width/nacf_layers: must be >= 0 / >= 1");
-  require(a.fraction > 0 && a.fraction <= 1, where + ".audio.fraction: must be in (0, 1] "
-                                                     "(--audio-fraction)");
+  require(a.fraction > 0 && a.fraction <= 1, where +
+                                                 ".audio.fraction: must be in (0, 1] "
+                                                 "(--audio-fraction)");
   require(a.start_step >= -1, where + ".audio.start_step: must be >= -1");
   require(a.decay_weight >= 0 && std::isfinite(a.decay_weight),
           where + ".audio.decay_weight: must be a number >= 0 (--decay-loss)");
@@ -131,8 +132,9 @@ void validate(const TrainConfig& c, const std::string& where) {
           where + ".audio.early_fraction: must be in [0, 1]");
   require(a.early_frames >= 1, where + ".audio.early_frames: must be at least 1");
   if (c.modality == Modality::audio)
-    require(!a.vision_run.empty(), where + ".audio.vision_run: required with --modality audio "
-                                           "(--vision-run)");
+    require(!a.vision_run.empty(), where +
+                                       ".audio.vision_run: required with --modality audio "
+                                       "(--vision-run)");
   if (c.modality != Modality::vision)
     require(a.start_step < c.steps, where + ".audio.start_step: audio starts after step " +
                                         std::to_string(a.start_step) + " but the run has only " +

@@ -1,9 +1,8 @@
 #pragma once
 // Training configuration: presets `cpu` (default) and `paper`, resolved once and saved beside the
 // run as RUN/config.json (JSON round trip through the same field tables as the model config).
-#include <nlohmann/json.hpp>
-
 #include <cstdint>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "neraf/nerf/config.h"
@@ -49,7 +48,7 @@ struct AudioConfig {
   int64_t cells_per_update = 4096;  // grid cells written per training step (round robin)
   int64_t nacf_width = 0;           // 0: the acoustic preset's NAcF trunk; else N layers of this
   int64_t nacf_layers = 5;          //    width (only used when nacf_width > 0)
-  double fraction = 1.0;            // few-shot: seeded fraction of the train RIRs used (--audio-fraction)
+  double fraction = 1.0;  // few-shot: seeded fraction of the train RIRs used (--audio-fraction)
   // Energy-decay loss (the paper's "++" variant, off in the reference): its weight (0 = off,
   // --decay-loss) and how many whole RIRs (all frames) per audio step it is computed on.
   double decay_weight = 0.0;
@@ -59,7 +58,7 @@ struct AudioConfig {
   // differences, C50 and EDT, are a few frames of ~100: uniform slices rarely show them.
   double early_fraction = 0.0;
   int64_t early_frames = 12;
-  std::string vision_run;           // modality audio: the finished vision run whose field is frozen
+  std::string vision_run;  // modality audio: the finished vision run whose field is frozen
   // "audio_fields" group: NAcF + ResNet3D (+ the radiance field in joint mode), Adam eps 1e-15,
   // sine warm-up from 1e-8 over warmup_steps then log-linear decay (neraf-reference.md §2.3).
   ScheduleConfig schedule{1e-4, 1e-8, 1002000, 2000, 1e-8, "sine", 1e-15};
@@ -86,17 +85,17 @@ struct AudioConfig {
 struct TrainConfig {
   std::string preset = "cpu";
   Modality modality = Modality::vision;
-  int64_t steps = 3000;              // total optimisation steps
-  int64_t rays_per_batch = 4096;     // vision rays per step
+  int64_t steps = 3000;           // total optimisation steps
+  int64_t rays_per_batch = 4096;  // vision rays per step
   uint64_t seed = 42;
-  int threads = 0;                   // 0: LibTorch's default (all cores)
-  int64_t save_every = 500;          // checkpoint period in steps (and always at the end)
+  int threads = 0;           // 0: LibTorch's default (all cores)
+  int64_t save_every = 500;  // checkpoint period in steps (and always at the end)
   int64_t eval_rays_per_chunk = 16384;
   ScheduleConfig fields;             // "fields" group: the radiance field
   ScheduleConfig proposal_networks;  // "proposal_networks" group
   ScheduleConfig camera_opt{1e-3, 1e-4, 5000};
   nerf::ModelConfig model;
-  AudioConfig audio;                 // the acoustic branch (modality audio / joint)
+  AudioConfig audio;  // the acoustic branch (modality audio / joint)
 
   template <class V>
   void visit(V& v) {

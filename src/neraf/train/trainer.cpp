@@ -9,8 +9,8 @@
 #include "neraf/nerf/samplers.h"
 #include "neraf/train/audio_branch.h"
 #include "neraf/train/checkpoint.h"
-#include "neraf/train/run.h"
 #include "neraf/train/lr_schedule.h"
+#include "neraf/train/run.h"
 #include "neraf/util/error.h"
 
 namespace neraf::train {
@@ -19,8 +19,14 @@ namespace {
 constexpr const char* kFormat = "neraf-checkpoint-1";
 
 // Settings that may differ between a checkpoint and the run loading it: run length and
-// bookkeeping, and the matmul precision (the master weights are fp32 either way).
+// bookkeeping, and the matmul precision (the master weights are fp32 either way). A schedule
+// whose decay is tied to the run length (max_steps == steps) follows --steps on resume, so it
+// compares as "the run length", not as a number.
 nlohmann::json comparable(nlohmann::json j) {
+  const nlohmann::json steps = j.value("steps", nlohmann::json());
+  for (nlohmann::json* s : {&j["fields"], &j["proposal_networks"], &j["audio"]["schedule"]})
+    if (s->is_object() && s->value("max_steps", nlohmann::json()) == steps)
+      (*s)["max_steps"] = "steps";
   for (const char* k : {"steps", "threads", "save_every", "eval_rays_per_chunk"}) j.erase(k);
   if (j.contains("model")) j["model"].erase("precision");
   // Vision runs ignore the acoustic settings (and checkpoints older than them have none).
@@ -97,20 +103,20 @@ LossDict VisionBranch::losses(StepContext& ctx) {
   const torch::Tensor col = rem - row * width_;
   const torch::Tensor gt = pixels_.index_select(0, idx).to(torch::kFloat32) / 255.0;  // [R, 3]
 
-  nerf::RayBundle rays = nerf::rays_from_pixels(
-      c2w_.index_select(0, img), intr_.index_select(0, img), col.to(torch::kFloat32) + 0.5,
-      row.to(torch::kFloat32) + 0.5);
+  nerf::RayBundle rays =
+      nerf::rays_from_pixels(c2w_.index_select(0, img), intr_.index_select(0, img),
+                             col.to(torch::kFloat32) + 0.5, row.to(torch::kFloat32) + 0.5);
   rays.camera_indices = img;
 
   const auto& sc = config_.model.sampler;
   const nerf::ProposalUpdate pu = nerf::proposal_update(
       ctx.step, steps_since_update_, sc.proposal_update_every, sc.proposal_warmup);
   steps_since_update_ = pu.steps_since_update;
-  const double anneal = sc.use_proposal_weight_anneal
-                            ? nerf::proposal_weight_anneal(ctx.step,
-                                                           sc.proposal_weights_anneal_slope,
-                                                           sc.proposal_weights_anneal_max_num_iters)
-                            : 1.0;
+  const double anneal =
+      sc.use_proposal_weight_anneal
+          ? nerf::proposal_weight_anneal(ctx.step, sc.proposal_weights_anneal_slope,
+                                         sc.proposal_weights_anneal_max_num_iters)
+          : 1.0;
   const nerf::ModelOutputs out = model_->forward(rays, {pu.update, anneal, &ctx.gen});
   LossDict l = model_->losses(out, gt);
   const double mse = l.at("rgb_loss").item<double>();
@@ -269,8 +275,9 @@ nlohmann::json check_checkpoint_header(torch::serialize::InputArchive& a, const 
   nlohmann::json stored;
   try {
     c10::IValue fmt;
-    require(a.try_read("format", fmt) && fmt.isString() && fmt.toStringRef() == kFormat,
-            path + ": not a neraf training checkpoint; point --run at a folder made by neraf train");
+    require(
+        a.try_read("format", fmt) && fmt.isString() && fmt.toStringRef() == kFormat,
+        path + ": not a neraf training checkpoint; point --run at a folder made by neraf train");
     c10::IValue cfg;
     a.read("config", cfg);
     stored = nlohmann::json::parse(cfg.toStringRef());
@@ -298,8 +305,9 @@ std::unique_ptr<Trainer> make_trainer(const TrainConfig& config, const data::Ima
   validate(config, "config");
   auto trainer = std::make_unique<Trainer>(config, device);
   if (config.modality != Modality::vision)
-    require(rirs != nullptr, "--data: an audio/joint run needs the scene's RIRs (SoundSpaces or "
-                             "RAF layout)");
+    require(rirs != nullptr,
+            "--data: an audio/joint run needs the scene's RIRs (SoundSpaces or "
+            "RAF layout)");
   if (config.modality == Modality::audio) {
     // The paper's separate training: the acoustic field on the frozen grid of a vision run.
     require(!config.audio.vision_run.empty(),
