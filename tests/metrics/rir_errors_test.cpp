@@ -81,6 +81,11 @@ TEST(CompareRirs, CombinesPerChannelMeasurements) {
                      std::abs(measure_c50(p1, fs) - measure_c50(g1, fs))),
               1e-12);
   EXPECT_GT(e.t60_error_pct, 10.0);  // 0.3 vs 0.4 s and 0.6 vs 0.5 s
+  // The measured values behind the errors: channel means.
+  EXPECT_NEAR(e.t60_pred_s, 0.5 * (tp0 + tp1), 1e-12);
+  EXPECT_NEAR(e.t60_gt_s, 0.5 * (tg0 + tg1), 1e-12);
+  EXPECT_NEAR(e.c50_pred_db, 0.5 * (measure_c50(p0, fs) + measure_c50(p1, fs)), 1e-12);
+  EXPECT_NEAR(e.c50_gt_db, 0.5 * (measure_c50(g0, fs) + measure_c50(g1, fs)), 1e-12);
   EXPECT_FALSE(e.invalid_t60);
   EXPECT_GT(e.stft_error, 0.0);
 }

@@ -53,8 +53,13 @@ void write_dataset(const fs::path& dir, const neraf::data::ImageSet& set) {
   add(set.train);
   add(set.eval);
   const auto& k = set.train.intrinsics[0];
-  const nlohmann::json t = {{"camera_model", "OPENCV"}, {"fl_x", k.fx}, {"fl_y", k.fy},
-                            {"cx", k.cx},  {"cy", k.cy},  {"w", k.width}, {"h", k.height},
+  const nlohmann::json t = {{"camera_model", "OPENCV"},
+                            {"fl_x", k.fx},
+                            {"fl_y", k.fy},
+                            {"cx", k.cx},
+                            {"cy", k.cy},
+                            {"w", k.width},
+                            {"h", k.height},
                             {"frames", frames}};
   neraf::io::write_json_atomically((dir / "transforms.json").string(), t);
 }

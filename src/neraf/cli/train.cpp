@@ -110,7 +110,7 @@ void register_train(CLI::App& app) {
   CLI::Option* decay_loss =
       cmd->add_option("--decay-loss", args->decay_loss,
                       "Weight of the energy-decay loss on whole RIRs (the paper's \"++\" "
-                      "variant; default: the preset's, cpu 1, paper 0 = off as the reference)")
+                      "variant; default 0 = off, as the reference)")
           ->check(CLI::NonNegativeNumber);
   cmd->add_option("--out", args->out, "Run folder to create (or to resume)")->required();
   cmd->add_flag("--resume", args->resume,

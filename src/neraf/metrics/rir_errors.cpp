@@ -78,6 +78,7 @@ RirErrors compare_rirs(const io::AudioBuffer& pred, const io::AudioBuffer& gt, V
   const int frames = stft_error_frames(length, params);
   const size_t n_ch = gt.channels.size();
 
+  RirErrors e;
   std::vector<double> t60_pred(n_ch), t60_gt(n_ch);
   double c50_sum = 0.0, edt_sum = 0.0, stft_sum = 0.0;
   for (size_t c = 0; c < n_ch; ++c) {
@@ -86,11 +87,15 @@ RirErrors compare_rirs(const io::AudioBuffer& pred, const io::AudioBuffer& gt, V
     t60_pred[c] = measure_t60(p, fs, variant).reference_t60();
     t60_gt[c] = measure_t60(g, fs, variant).reference_t60();
     edt_sum += std::abs(measure_edt(p, fs).reference_edt() - measure_edt(g, fs).reference_edt());
-    c50_sum += std::abs(measure_c50(p, fs) - measure_c50(g, fs));
+    const double c50_p = measure_c50(p, fs), c50_g = measure_c50(g, fs);
+    c50_sum += std::abs(c50_p - c50_g);
     stft_sum += stft_error(p, g, params, frames);
+    e.t60_pred_s += t60_pred[c] / double(n_ch);
+    e.t60_gt_s += t60_gt[c] / double(n_ch);
+    e.c50_pred_db += c50_p / double(n_ch);
+    e.c50_gt_db += c50_g / double(n_ch);
   }
 
-  RirErrors e;
   e.t60_error_pct = t60_error_pct(t60_pred, t60_gt, &e.invalid_t60);
   e.c50_error_db = c50_sum / double(n_ch);
   e.edt_error_s = edt_sum / double(n_ch);

@@ -26,6 +26,10 @@ struct RirErrors {
   double edt_error_s = 0.0;
   double stft_error = 0.0;
   bool invalid_t60 = false;
+  // The measured values behind the errors, averaged over channels (not used by the metrics; they
+  // show a bias that absolute errors hide). T60 in seconds (reference rule, −1 when invalid).
+  double t60_pred_s = 0.0, t60_gt_s = 0.0;
+  double c50_pred_db = 0.0, c50_gt_db = 0.0;
 };
 
 // The reference's T60 rule on per-channel values (−1 = invalid, anything < −0.5 counts):

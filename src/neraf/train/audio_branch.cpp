@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "neraf/acoustic/calibration.h"
 #include "neraf/acoustic/losses.h"
 #include "neraf/train/audio_run.h"
 #include "neraf/train/checkpoint.h"
@@ -179,6 +180,33 @@ LossDict AudioBranch::losses(StepContext& ctx) {
   return out;
 }
 
+torch::Tensor AudioBranch::energy_calibration() {
+  const int64_t C = rirs_.channels, F = rirs_.n_freq, T = rirs_.max_len;
+  if (!config_.audio.energy_calibration) return torch::ones({C, F, T});
+  torch::NoGradGuard no_grad;
+  const bool was_training = model_->is_training();
+  model_->eval();
+  const torch::Tensor feature = model_->scene_feature(grid_->grid().detach());  // [G] or none
+  const int64_t n = static_cast<int64_t>(train_rirs_.size());
+  const int64_t stride = std::max<int64_t>(1, n / 512);
+  torch::Tensor gt_energy = torch::zeros({C, F, T}, torch::kFloat64),
+                pred_energy = gt_energy.clone();
+  for (int64_t k = 0; k < n; k += stride) {
+    const int64_t i = train_rirs_[static_cast<size_t>(k)];
+    const torch::Tensor idx = torch::tensor({i}, torch::kInt64);
+    const torch::Tensor mic =
+        data::normalize_position(rirs_.mic_positions.index_select(0, idx), rirs_.audio_aabb);
+    const torch::Tensor src =
+        data::normalize_position(rirs_.source_positions.index_select(0, idx), rirs_.audio_aabb);
+    const torch::Tensor pred = model_->render_stft_with_feature(
+        feature, mic.to(device_), src.to(device_), rirs_.rots[i].to(device_));  // [C, F, T]
+    pred_energy += acoustic::bin_energy(pred.cpu());
+    gt_energy += acoustic::bin_energy(rirs_.features(i));
+  }
+  model_->train(was_training);
+  return acoustic::calibration_gain(gt_energy, pred_energy);
+}
+
 void AudioBranch::save(torch::serialize::OutputArchive& archive) {
   torch::serialize::OutputArchive m, g;
   model_->save(m);
@@ -192,6 +220,7 @@ void AudioBranch::save(torch::serialize::OutputArchive& archive) {
   archive.write("cursor", torch::tensor(cursor_, torch::kInt64));
   archive.write("manifest", c10::IValue(make_audio_manifest(rirs_).dump()));
   archive.write("train_rirs", torch::tensor(train_rirs_, torch::kInt64));
+  archive.write("calibration", energy_calibration());
 }
 
 void AudioBranch::load(torch::serialize::InputArchive& archive, const std::string& where) {

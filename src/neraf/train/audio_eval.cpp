@@ -205,14 +205,15 @@ nlohmann::json to_json(const AudioEval& e) {
 
 void write_audio_csv(const std::string& path, const AudioEval& e) {
   std::ostringstream out;
-  out << "rir_id,method,t60_error_pct,c50_error_db,edt_error_s,stft_error,invalid_t60\n";
-  char buf[256];
+  out << "rir_id,method,t60_error_pct,c50_error_db,edt_error_s,stft_error,invalid_t60,"
+         "t60_pred_s,t60_gt_s,c50_pred_db,c50_gt_db\n";
+  char buf[320];
   for (const auto& m : e.methods)
     for (size_t n = 0; n < m.per_rir.size() && n < e.rir_ids.size(); ++n) {
       const auto& r = m.per_rir[n];
-      std::snprintf(buf, sizeof buf, ",%s,%.6g,%.6g,%.6g,%.6g,%d\n", m.name.c_str(),
-                    r.t60_error_pct, r.c50_error_db, r.edt_error_s, r.stft_error,
-                    r.invalid_t60 ? 1 : 0);
+      std::snprintf(buf, sizeof buf, ",%s,%.6g,%.6g,%.6g,%.6g,%d,%.6g,%.6g,%.6g,%.6g\n",
+                    m.name.c_str(), r.t60_error_pct, r.c50_error_db, r.edt_error_s, r.stft_error,
+                    r.invalid_t60 ? 1 : 0, r.t60_pred_s, r.t60_gt_s, r.c50_pred_db, r.c50_gt_db);
       out << e.rir_ids[n] << buf;
     }
   io::write_text_atomically(path, out.str());

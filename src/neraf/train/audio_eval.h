@@ -70,7 +70,9 @@ AudioMethodEval evaluate_audio_model(const AudioRun& run, const data::RirSet& ri
 nlohmann::json to_json(const metrics::RirErrorSummary& s);
 // {"neraf": {...}, "nearest": {...}, "linear": {...}}
 nlohmann::json to_json(const AudioEval& e);
-// Writes "rir_id,method,t60_error_pct,c50_error_db,edt_error_s,stft_error,invalid_t60" rows.
+// Writes "rir_id,method,t60_error_pct,c50_error_db,edt_error_s,stft_error,invalid_t60,
+// t60_pred_s,t60_gt_s,c50_pred_db,c50_gt_db" rows (the last four: channel means of the measured
+// values, to show a bias).
 void write_audio_csv(const std::string& path, const AudioEval& e);
 // A fixed-width table of the methods' means.
 std::string audio_table(const std::vector<AudioMethodEval>& methods);

@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "neraf/acoustic/calibration.h"
 #include "neraf/dsp/griffin_lim.h"
 #include "neraf/io/json_file.h"
 #include "neraf/train/audio_branch.h"
@@ -131,7 +132,9 @@ std::vector<std::vector<float>> griffin_lim_channels(const torch::Tensor& magnit
 torch::Tensor AudioRun::predict_normalised(const torch::Tensor& mic_norm,
                                            const torch::Tensor& src_norm,
                                            const torch::Tensor& rot) const {
-  return model_->render_stft_with_feature(feature_, mic_norm, src_norm, rot);  // [C, F, T]
+  const torch::Tensor raw = model_->render_stft_with_feature(feature_, mic_norm, src_norm, rot);
+  return calibration_.defined() ? acoustic::apply_calibration(raw, calibration_)
+                                : raw;  // [C, F, T]
 }
 
 torch::Tensor AudioRun::predict_log_stft(const geometry::Vec3& mic, const geometry::Vec3& src,
@@ -208,6 +211,9 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
     load_module(*out.model_, m, out.run_.checkpoint);
     branch.read("grid", g);
     load_module(*grid, g, out.run_.checkpoint);
+    c10::IValue calibration;  // absent in checkpoints written before it existed
+    if (out.run_.config.audio.energy_calibration && branch.try_read("calibration", calibration))
+      out.calibration_ = calibration.toTensor().to(device);
     torch::Tensor step;
     a.read("step", step);
     out.run_.step = step.item<int64_t>();

@@ -77,7 +77,8 @@ class AudioRun {
                                                    const geometry::Vec3& src, double yaw_deg,
                                                    uint64_t seed = 0, int64_t length = 0) const;
 
-  // Low level: normalised inputs (mic_norm, src_norm, rot: [3] each) → [C, F, T].
+  // Low level: normalised inputs (mic_norm, src_norm, rot: [3] each) → [C, F, T], with the
+  // checkpoint's energy calibration applied when it has one.
   torch::Tensor predict_normalised(const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
                                    const torch::Tensor& rot) const;
   acoustic::AcousticModel& model() const { return model_; }
@@ -88,6 +89,7 @@ class AudioRun {
   AudioRunInfo info_;
   mutable acoustic::AcousticModel model_{nullptr};
   torch::Tensor feature_;  // [G] scene feature (eval-mode ResNet3D on the saved grid) or undefined
+  torch::Tensor calibration_;  // [C, F, T] energy gains (acoustic/calibration.h) or undefined
 };
 
 // Loads RUN (latest checkpoint, or `checkpoint`) with its acoustic field. neraf::Error when the

@@ -41,6 +41,7 @@ TrainConfig train_preset(const std::string& name) {
     c.audio.cells_per_update = 4096;
     c.audio.batch_size = 2048;
     c.audio.start_step = 2000;
+    c.audio.energy_calibration = false;  // the reference renders the raw prediction
     return c;
   }
   // cpu: a few thousand steps. The learning rate decays over the run itself (nerfstudio's

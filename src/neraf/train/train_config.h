@@ -58,6 +58,9 @@ struct AudioConfig {
   // differences, C50 and EDT, are a few frames of ~100: uniform slices rarely show them.
   double early_fraction = 0.0;
   int64_t early_frames = 12;
+  // Per-frame energy gains fitted on the train RIRs, applied at inference (ours, off in the
+  // paper preset; acoustic/calibration.h).
+  bool energy_calibration = true;
   std::string vision_run;  // modality audio: the finished vision run whose field is frozen
   // "audio_fields" group: NAcF + ResNet3D (+ the radiance field in joint mode), Adam eps 1e-15,
   // sine warm-up from 1e-8 over warmup_steps then log-linear decay (neraf-reference.md §2.3).
@@ -77,6 +80,7 @@ struct AudioConfig {
     v("decay_rirs", decay_rirs);
     v("early_fraction", early_fraction);
     v("early_frames", early_frames);
+    v("energy_calibration", energy_calibration);
     v("vision_run", vision_run);
     v("schedule", schedule);
   }

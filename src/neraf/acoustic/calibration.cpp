@@ -1,0 +1,40 @@
+#include "neraf/acoustic/calibration.h"
+
+#include <torch/torch.h>
+
+namespace neraf::acoustic {
+
+namespace {
+constexpr double kFloor = 1e-3;  // the log-magnitude offset, neraf-reference.md §4.1
+
+torch::Tensor magnitude(const torch::Tensor& log_stft) {
+  return torch::clamp(torch::exp(log_stft.to(torch::kFloat64)) - kFloor, 0.0, 1e4);
+}
+}  // namespace
+
+torch::Tensor bin_energy(const torch::Tensor& log_stft) {
+  TORCH_CHECK(log_stft.dim() >= 3, "bin_energy: expected [..., C, F, T], got ", log_stft.sizes());
+  const int64_t C = log_stft.size(-3), F = log_stft.size(-2), T = log_stft.size(-1);
+  return magnitude(log_stft).pow(2).reshape({-1, C, F, T}).sum(0);  // [C, F, T]
+}
+
+torch::Tensor calibration_gain(const torch::Tensor& gt_energy, const torch::Tensor& pred_energy) {
+  TORCH_CHECK(gt_energy.dim() == 3 && gt_energy.sizes() == pred_energy.sizes(),
+              "calibration_gain: expected two [C, F, T] energies, got ", gt_energy.sizes(), " and ",
+              pred_energy.sizes());
+  const torch::Tensor gt = gt_energy.to(torch::kFloat64), pred = pred_energy.to(torch::kFloat64);
+  const torch::Tensor both = (gt > 0) & (pred > 0);
+  const torch::Tensor ratio = torch::where(both, gt / pred.clamp_min(1e-300), torch::ones_like(gt));
+  return ratio.sqrt().clamp(1.0 / kMaxCalibrationGain, kMaxCalibrationGain).to(torch::kFloat32);
+}
+
+torch::Tensor apply_calibration(const torch::Tensor& log_stft, const torch::Tensor& gain) {
+  TORCH_CHECK(log_stft.dim() >= 3 && gain.dim() == 3 &&
+                  gain.sizes() == log_stft.sizes().slice(log_stft.dim() - 3),
+              "apply_calibration: gain ", gain.sizes(), " does not match [..., C, F, T] ",
+              log_stft.sizes());
+  const torch::Tensor g = gain.to(log_stft.device(), torch::kFloat64);  // [C, F, T]
+  return torch::log(magnitude(log_stft) * g + kFloor).to(log_stft.scalar_type());
+}
+
+}  // namespace neraf::acoustic
