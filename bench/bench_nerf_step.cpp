@@ -30,11 +30,11 @@ struct StepBench {
     const int64_t num_images = 100;
     model = NerfactoModel(cfg, num_images, 42);
     model->train();
-    for (auto group : {model->proposal_parameters(), model->field_parameters(),
-                       model->camera_parameters()}) {
+    for (auto group :
+         {model->proposal_parameters(), model->field_parameters(), model->camera_parameters()}) {
       if (group.empty()) continue;
-      optimizers.push_back(std::make_unique<torch::optim::Adam>(
-          group, torch::optim::AdamOptions(1e-2).eps(1e-15)));
+      optimizers.push_back(
+          std::make_unique<torch::optim::Adam>(group, torch::optim::AdamOptions(1e-2).eps(1e-15)));
       for (auto& p : group) params.push_back(p);
     }
     // Rays from inside the unit cube in random directions, like a room seen from within.
@@ -58,13 +58,15 @@ struct StepBench {
 
 void run(benchmark::State& state, const std::string& preset, Precision precision,
          bool proposal_grad) {
+  // The benchmark's argument is the thread count (LibTorch's default here is 1, not the cores).
+  torch::set_num_threads(static_cast<int>(state.range(0)));
   const int64_t num_rays = 4096;
   StepBench b(preset, precision, num_rays);
   b.step(true);  // warm-up: allocations, oneDNN kernel selection
   b.step(proposal_grad);
   for (auto _ : state) b.step(proposal_grad);
-  state.counters["rays/s"] =
-      benchmark::Counter(static_cast<double>(num_rays), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["rays/s"] = benchmark::Counter(static_cast<double>(num_rays),
+                                                benchmark::Counter::kIsIterationInvariantRate);
   state.counters["threads"] = torch::get_num_threads();
 }
 
@@ -79,13 +81,45 @@ void BM_Step_cpu_fp32_noupdate(benchmark::State& s) { run(s, "cpu", Precision::f
 
 }  // namespace
 
-BENCHMARK(BM_Step_paper_fp32_update)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK(BM_Step_paper_fp32_noupdate)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK(BM_Step_paper_bf16_update)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK(BM_Step_paper_bf16_noupdate)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK(BM_Step_cpu_bf16_update)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK(BM_Step_cpu_bf16_noupdate)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK(BM_Step_cpu_fp32_update)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK(BM_Step_cpu_fp32_noupdate)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_Step_paper_fp32_update)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0)
+    ->UseRealTime();
+BENCHMARK(BM_Step_paper_fp32_noupdate)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0)
+    ->UseRealTime();
+BENCHMARK(BM_Step_paper_bf16_update)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0)
+    ->UseRealTime();
+BENCHMARK(BM_Step_paper_bf16_noupdate)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0)
+    ->UseRealTime();
+BENCHMARK(BM_Step_cpu_bf16_update)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0)
+    ->UseRealTime();
+BENCHMARK(BM_Step_cpu_bf16_noupdate)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0)
+    ->UseRealTime();
+BENCHMARK(BM_Step_cpu_fp32_update)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0)
+    ->UseRealTime();
+BENCHMARK(BM_Step_cpu_fp32_noupdate)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0)
+    ->UseRealTime();
 
 // main() (with the malloc tuning of the neraf program) is defined in bench_nerf_ops.cpp.
