@@ -7,9 +7,12 @@
 //   build-x/neraf_bench_acoustic --benchmark_filter=cpu
 // Without --benchmark_out the JSON goes to <repo>/bench/results/acoustic.json.
 #include <benchmark/benchmark.h>
+#include <malloc.h>
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "neraf/acoustic/acoustic_model.h"
@@ -201,6 +204,10 @@ NERAF_PAPER(BM_RenderStftCachedFeature, 1);
 }  // namespace neraf::acoustic
 
 int main(int argc, char** argv) {
+  // As the neraf program: all cores (LibTorch's default here is 1 thread) and no mmap churn.
+  torch::set_num_threads(static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  mallopt(M_MMAP_MAX, 0);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
   std::vector<char*> args(argv, argv + argc);
   bool has_out = false;
   for (int i = 1; i < argc; ++i) {
