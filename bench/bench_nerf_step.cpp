@@ -2,8 +2,9 @@
 // backward → Adam on the three groups), at the paper (Nerfacto default) and cpu preset shapes,
 // with fp32 and bf16 MLPs, with and without the proposal-network update (steady state updates
 // them on 1 step in 6, so the amortised step is (update + 5·no_update)/6).
-// Run: neraf_bench_nerf --benchmark_filter=Step_ --benchmark_repetitions=5 \
-//        --benchmark_out=bench/results/nerf_step.json --benchmark_out_format=json
+// Run each in its own process (the heap left by one benchmark slows the next by up to 30 %):
+//   neraf_bench_nerf --benchmark_filter='BM_Step_paper_bf16_update/' --benchmark_repetitions=5 \
+//     --benchmark_out=step.json --benchmark_out_format=json
 #include <ATen/CPUGeneratorImpl.h>
 #include <benchmark/benchmark.h>
 #include <torch/torch.h>
@@ -81,45 +82,15 @@ void BM_Step_cpu_fp32_noupdate(benchmark::State& s) { run(s, "cpu", Precision::f
 
 }  // namespace
 
-BENCHMARK(BM_Step_paper_fp32_update)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(2.0)
-    ->UseRealTime();
-BENCHMARK(BM_Step_paper_fp32_noupdate)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(2.0)
-    ->UseRealTime();
-BENCHMARK(BM_Step_paper_bf16_update)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(2.0)
-    ->UseRealTime();
-BENCHMARK(BM_Step_paper_bf16_noupdate)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(2.0)
-    ->UseRealTime();
-BENCHMARK(BM_Step_cpu_bf16_update)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(2.0)
-    ->UseRealTime();
-BENCHMARK(BM_Step_cpu_bf16_noupdate)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(2.0)
-    ->UseRealTime();
-BENCHMARK(BM_Step_cpu_fp32_update)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(2.0)
-    ->UseRealTime();
-BENCHMARK(BM_Step_cpu_fp32_noupdate)
-    ->Arg(2)
-    ->Unit(benchmark::kMillisecond)
-    ->MinTime(2.0)
-    ->UseRealTime();
+// 2 threads (the machines' cores; LibTorch's default here is 1), wall-clock time.
+#define NERAF_STEP_BENCH ->Arg(2)->Unit(benchmark::kMillisecond)->MinTime(2.0)->UseRealTime()
+BENCHMARK(BM_Step_paper_fp32_update) NERAF_STEP_BENCH;
+BENCHMARK(BM_Step_paper_fp32_noupdate) NERAF_STEP_BENCH;
+BENCHMARK(BM_Step_paper_bf16_update) NERAF_STEP_BENCH;
+BENCHMARK(BM_Step_paper_bf16_noupdate) NERAF_STEP_BENCH;
+BENCHMARK(BM_Step_cpu_bf16_update) NERAF_STEP_BENCH;
+BENCHMARK(BM_Step_cpu_bf16_noupdate) NERAF_STEP_BENCH;
+BENCHMARK(BM_Step_cpu_fp32_update) NERAF_STEP_BENCH;
+BENCHMARK(BM_Step_cpu_fp32_noupdate) NERAF_STEP_BENCH;
 
 // main() (with the malloc tuning of the neraf program) is defined in bench_nerf_ops.cpp.
