@@ -7,10 +7,14 @@ namespace neraf::acoustic {
 namespace {
 constexpr double kFloor = 1e-3;  // the log-magnitude offset, neraf-reference.md §4.1
 
-torch::Tensor magnitude(const torch::Tensor& log_stft) {
-  return torch::clamp(torch::exp(log_stft.to(torch::kFloat64)) - kFloor, 0.0, 1e4);
+torch::Tensor magnitude(const torch::Tensor& log_stft) {  // in float64: energies are summed
+  return log_stft_to_magnitude(log_stft.to(torch::kFloat64));
 }
 }  // namespace
+
+torch::Tensor log_stft_to_magnitude(const torch::Tensor& log_stft) {
+  return torch::clamp(torch::exp(log_stft) - kFloor, 0.0, 1e4);
+}
 
 torch::Tensor bin_energy(const torch::Tensor& log_stft) {
   TORCH_CHECK(log_stft.dim() >= 3, "bin_energy: expected [..., C, F, T], got ", log_stft.sizes());

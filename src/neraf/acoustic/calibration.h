@@ -19,6 +19,10 @@ namespace neraf::acoustic {
 
 constexpr double kMaxCalibrationGain = 10.0;
 
+// NAcF's output decoding, mag = clip(exp(log_stft) − 1e-3, 0, 1e4) (neraf-reference.md §4.1).
+// Any shape, the input's dtype.
+torch::Tensor log_stft_to_magnitude(const torch::Tensor& log_stft);
+
 // log_stft: [..., C, F, T] → [C, F, T] float64 energies summed over all leading dims.
 torch::Tensor bin_energy(const torch::Tensor& log_stft);
 

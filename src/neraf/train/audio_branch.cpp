@@ -188,7 +188,7 @@ torch::Tensor AudioBranch::energy_calibration() {
   model_->eval();
   const torch::Tensor feature = model_->scene_feature(grid_->grid().detach());  // [G] or none
   const int64_t n = static_cast<int64_t>(train_rirs_.size());
-  const int64_t stride = std::max<int64_t>(1, n / 512);
+  const int64_t stride = std::max<int64_t>(1, (n + 511) / 512);  // at most 512 RIRs
   torch::Tensor gt_energy = torch::zeros({C, F, T}, torch::kFloat64),
                 pred_energy = gt_energy.clone();
   for (int64_t k = 0; k < n; k += stride) {

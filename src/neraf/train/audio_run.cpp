@@ -103,10 +103,6 @@ void check_audio_manifest(const nlohmann::json& manifest, const data::RirSet& ri
                 now[key].dump() + "); use the original --data or a new --out folder");
 }
 
-torch::Tensor log_stft_to_magnitude(const torch::Tensor& log_stft) {
-  return torch::clamp(torch::exp(log_stft) - 1e-3, 0.0, 1e4);
-}
-
 std::vector<std::vector<float>> griffin_lim_channels(const torch::Tensor& magnitude,
                                                      const dsp::StftParams& stft, uint64_t seed,
                                                      int64_t length) {

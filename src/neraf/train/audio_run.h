@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "neraf/acoustic/acoustic_model.h"
+#include "neraf/acoustic/calibration.h"
 #include "neraf/data/rir_set.h"
 #include "neraf/dsp/stft.h"
 #include "neraf/geometry/vec.h"
@@ -52,7 +53,7 @@ void check_audio_manifest(const nlohmann::json& manifest, const data::RirSet& ri
                           const std::string& where);
 
 // mag = clip(exp(log_stft) − 1e-3, 0, 1e4) (neraf-reference.md §4.1). Any shape.
-torch::Tensor log_stft_to_magnitude(const torch::Tensor& log_stft);
+using acoustic::log_stft_to_magnitude;
 // Griffin-Lim (32 iterations, momentum 0.99, seeded random init) of [C, F, T] magnitudes →
 // C waveforms of length hop·(T−1), zero-padded/cut to `length` if length > 0.
 std::vector<std::vector<float>> griffin_lim_channels(const torch::Tensor& magnitude,
