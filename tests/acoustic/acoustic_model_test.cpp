@@ -13,6 +13,8 @@ AcousticModelOptions small_options(GridMode mode) {
   o.grid_mode = mode;
   o.nacf.trunk = {64, 64};
   o.nacf.bf16 = false;
+  o.nacf.relative_geometry = false;  // the reference's input layout and position encoding
+  o.nacf.position_max_freq_exp = 8.0;
   return o;
 }
 
@@ -29,14 +31,16 @@ TEST(AcousticModel, PresetsResolveSizes) {
   const auto cpu = acoustic_preset("cpu", 2, 257, 78);
   EXPECT_EQ(cpu.grid.resolution, 32);
   EXPECT_EQ(cpu.grid.cells_per_update, 1024);
-  EXPECT_EQ(cpu.nacf.in_features(), 256 + 163);
+  EXPECT_EQ(cpu.nacf.in_features(), 256 + 163 + kRelativeGeometryDim);
   EXPECT_TRUE(cpu.nacf.bf16);
+  EXPECT_TRUE(cpu.nacf.relative_geometry);
   const auto paper = acoustic_preset("paper", 1, 513, 60);
   EXPECT_EQ(paper.grid.resolution, 128);
   EXPECT_EQ(paper.grid.cells_per_update, 4096);
   EXPECT_EQ(paper.nacf.in_features(), 1187);
   EXPECT_EQ(paper.nacf.trunk, (std::vector<int64_t>{5096, 2048, 1024, 1024, 512}));
   EXPECT_FALSE(paper.nacf.bf16);
+  EXPECT_FALSE(paper.nacf.relative_geometry);
   EXPECT_THROW(acoustic_preset("gpu", 1, 513, 60), std::exception);
   EXPECT_EQ(parse_grid_mode("zeros"), GridMode::kZeros);
   EXPECT_THROW(parse_grid_mode("off"), std::exception);
@@ -79,6 +83,22 @@ TEST(AcousticModel, NoneModeUsesNoGridLayout) {
   const auto y = m->forward(torch::Tensor(), b.t, b.mic, b.src, b.rot);
   EXPECT_EQ(y.sizes(), (std::vector<int64_t>{4, 2, 33}));
   const auto h = nacf_input(torch::Tensor(), b.t, 12, b.mic, b.src, b.rot);
+  EXPECT_TRUE(torch::allclose(y, m->field()->forward(h)));
+}
+
+TEST(AcousticModel, RelativeGeometryIsAppendedAfterTheReferenceInputs) {
+  torch::manual_seed(4);
+  auto o = small_options(GridMode::kNone);
+  o.nacf.relative_geometry = true;
+  o.nacf.extent_m = {4, 2, 3};
+  o.nacf.position_max_freq_exp = 1.0;
+  AcousticModel m(o);
+  EXPECT_EQ(m->field()->options().in_features(), 163 + kRelativeGeometryDim);
+  const auto b = random_batch(4, 12);
+  const auto y = m->forward(torch::Tensor(), b.t, b.mic, b.src, b.rot);
+  const auto h = torch::cat({nacf_input(torch::Tensor(), b.t, 12, b.mic, b.src, b.rot, 1.0),
+                             encode_relative_geometry(b.mic, b.src, b.rot, {4, 2, 3})},
+                            1);
   EXPECT_TRUE(torch::allclose(y, m->field()->forward(h)));
 }
 

@@ -52,5 +52,23 @@ TEST(EnergyCalibration, GainIsClampedAndKeepsShapeAndDtype) {
   EXPECT_THROW(apply_calibration(x, torch::ones({2, 1, 1})), c10::Error);
 }
 
+TEST(EnergyCalibration, EarlyBalanceScalesTheFramesBeforeTheC50Split) {
+  // SoundSpaces: split 1103 samples, hop 128 → frames 0..8 (centre 1024 < 1103) are early.
+  const auto gain = torch::full({2, 3, 12}, 0.5);  // [C, F, T]
+  const auto delta = torch::tensor({20.0 * std::log10(2.0), -20.0 * std::log10(2.0)},
+                                   torch::kFloat64);  // ×2, ×0.5
+  const torch::Tensor g = with_early_balance(gain, delta, 128, 1103);
+  ASSERT_EQ(g.sizes(), gain.sizes());
+  EXPECT_EQ(g.scalar_type(), torch::kFloat32);
+  for (int64_t t = 0; t < 12; ++t) {
+    EXPECT_NEAR(g[0][1][t].item<float>(), t <= 8 ? 1.0f : 0.5f, 1e-6) << t;
+    EXPECT_NEAR(g[1][2][t].item<float>(), t <= 8 ? 0.25f : 0.5f, 1e-6) << t;
+  }
+  // Clamped like the gains themselves; a split past the last frame scales every frame.
+  const auto big = with_early_balance(torch::ones({1, 1, 3}), torch::tensor({60.0}), 128, 10000);
+  EXPECT_TRUE(torch::allclose(big, torch::full({1, 1, 3}, kMaxCalibrationGain)));
+  EXPECT_THROW(with_early_balance(gain, torch::zeros({3}), 128, 1103), c10::Error);
+}
+
 }  // namespace
 }  // namespace neraf::acoustic

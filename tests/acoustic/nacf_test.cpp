@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include <array>
 #include <cmath>
 
 #include "neraf/acoustic/positional_encoding.h"
@@ -35,6 +36,60 @@ TEST(Nacf, DefaultLinearInitBounds) {
   EXPECT_LE(p["soundfield.0.weight"].abs().max().item<double>(), bound);
   EXPECT_GT(p["soundfield.0.weight"].abs().max().item<double>(), 0.99 * bound);
   EXPECT_LE(p["soundfield.0.bias"].abs().max().item<double>(), bound);
+}
+
+// rot as the datasets store a heading of `deg` degrees: ((cosθ+1)/2, 0.5, (sinθ+1)/2).
+torch::Tensor stored_rot(double deg) {
+  const double a = deg * M_PI / 180.0;
+  return torch::tensor({{(std::cos(a) + 1) / 2, 0.5, (std::sin(a) + 1) / 2}}, torch::kFloat64);
+}
+
+TEST(Nacf, RelativeGeometryHandComputed) {
+  // Audio box 4 × 2 × 4 m; source 1 m along +x from the mic, listener heading 90°.
+  const auto mic = torch::tensor({{0.5, 0.5, 0.5}}, torch::kFloat64);
+  const auto src = torch::tensor({{0.75, 0.5, 0.5}}, torch::kFloat64);
+  const auto g = encode_relative_geometry(mic, src, stored_rot(90), {4, 2, 4});
+  ASSERT_EQ(g.sizes(), (std::vector<int64_t>{1, kRelativeGeometryDim}));
+  EXPECT_EQ(g.dtype(), torch::kFloat32);
+  // φ = 0, θ = 90°: φ − θ = −90°, φ + θ = 90°, for k = 1, 2, 3 (cos, sin of each).
+  const double expected_angles[] = {0, -1, 0, 1, -1, 0, -1, 0, 0, 1, 0, -1};
+  for (int i = 0; i < 12; ++i) EXPECT_NEAR(g[0][i].item<double>(), expected_angles[i], 1e-6) << i;
+  EXPECT_NEAR(g[0][12].item<double>(), 0.0, 1e-6);  // level with the listener
+  EXPECT_NEAR(g[0][13].item<double>(), 1.0, 1e-6);
+  const double rel = 1.0 / 6.0;  // |d| = 1 m, box diagonal √(16 + 4 + 16) = 6 m
+  EXPECT_NEAR(g[0][14].item<double>(), rel, 1e-6);
+  EXPECT_NEAR(g[0][15].item<double>(), 0.0, 1e-6);  // ln 1
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(g[0][16 + 2 * k].item<double>(), std::sin(2 * M_PI * (1 << k) * rel), 1e-6);
+    EXPECT_NEAR(g[0][17 + 2 * k].item<double>(), std::cos(2 * M_PI * (1 << k) * rel), 1e-6);
+  }
+  // Straight above: elevation 1; the distance is clamped to 5 cm when the two coincide.
+  const auto up = encode_relative_geometry(mic, torch::tensor({{0.5, 1.0, 0.5}}, torch::kFloat64),
+                                           stored_rot(0), {4, 2, 4});
+  EXPECT_NEAR(up[0][12].item<double>(), 1.0, 1e-6);
+  const auto same = encode_relative_geometry(mic, mic, stored_rot(0), {4, 2, 4});
+  EXPECT_NEAR(same[0][15].item<double>(), std::log(0.05), 1e-6);
+}
+
+TEST(Nacf, RelativeGeometryFollowsTheListenerNotTheRoom) {
+  // Turning the source direction and the heading by the same angle about y leaves the
+  // heading-relative features (φ − θ) and the distance features unchanged.
+  const std::array<double, 3> extent{4, 2, 4};
+  const auto mic = torch::tensor({{0.5, 0.4, 0.5}}, torch::kFloat64);
+  auto source_at = [&](double deg) {
+    const double a = deg * M_PI / 180.0;  // 1.2 m away at azimuth 30° + deg, 0.2 m higher
+    return torch::tensor(
+        {{0.5 + 1.2 * std::cos(a + M_PI / 6) / 4, 0.5, 0.5 + 1.2 * std::sin(a + M_PI / 6) / 4}},
+        torch::kFloat64);
+  };
+  const auto a = encode_relative_geometry(mic, source_at(0), stored_rot(10), extent);
+  for (double turn : {90.0, 180.0, -35.0}) {
+    const auto b = encode_relative_geometry(mic, source_at(turn), stored_rot(10 + turn), extent);
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 2; ++j)  // cos and sin of k(φ − θ)
+        EXPECT_NEAR(a[0][4 * k + j].item<double>(), b[0][4 * k + j].item<double>(), 1e-5);
+    EXPECT_TRUE(torch::allclose(a.slice(1, 12), b.slice(1, 12), 1e-5, 1e-6));
+  }
 }
 
 TEST(Nacf, ShapesAndTanhRange) {

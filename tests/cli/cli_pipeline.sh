@@ -33,6 +33,21 @@ for key in '"neraf"' '"nearest"' '"linear"' '"t60_error_pct"' '"psnr"'; do
   expect_in "$TMP/eval.json" "$key"
 done
 expect_file "$R/eval/audio_per_rir.csv"
+# New microphone positions in the same room, and an ablation run with absolute positions only.
+expect_exit 0 "$NERAF" synth --preset demo --layout soundspaces --mics random --mic-count 2 \
+  --out "$TMP/novel" --seed 4 --quiet
+expect_exit 0 "$NERAF" train --data "$S" --modality audio --vision-run "$R" --steps 2 \
+  --no-relative-geometry --out "$TMP/absolute" --quiet
+expect_exit 0 "$NERAF" eval --run "$R" --json "$TMP/novel.json" --skip-vision --max-rirs 3 \
+  --novel-data "$TMP/novel" --ablation-runs "$TMP/absolute" --quiet
+for key in '"novel"' '"absolute"' '"relative_geometry": false'; do
+  expect_in "$TMP/novel.json" "$key"
+done
+expect_in "$TMP/out" "new microphone positions"
+expect_file "$R/eval/audio_novel_per_rir.csv"
+expect_exit 0 "$NERAF" synth --preset demo --layout raf --out "$TMP/raf" --seed 4 --quiet
+expect_exit 1 "$NERAF" eval --run "$R" --json "$TMP/x.json" --skip-vision --novel-data "$TMP/raf"
+expect_in "$TMP/err" "differs from the run's"
 expect_exit 1 "$NERAF" eval --run "$TMP/no-such-run" --json "$TMP/x.json"
 expect_in "$TMP/err" "no-such-run"
 

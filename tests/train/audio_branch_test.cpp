@@ -158,7 +158,7 @@ TEST(AudioBaselines, NearestPicksSameHeadingAndSourceClosestMic) {
   };
   const std::vector<int64_t> train = {1, 2, 3, 4, 5};
   std::vector<double> d;
-  const auto nb = nearest_training_rirs(set, train, 0, 4, &d);
+  const auto nb = nearest_training_rirs(set, train, set.rirs[0], 4, &d);
   ASSERT_EQ(nb.size(), 3u);  // only 3, 4, 5 qualify
   EXPECT_EQ(nb[0], 4);
   EXPECT_EQ(nb[1], 5);
@@ -166,12 +166,12 @@ TEST(AudioBaselines, NearestPicksSameHeadingAndSourceClosestMic) {
   EXPECT_NEAR(d[0], 0.6, 1e-12);
   EXPECT_NEAR(d[2], 1.0, 1e-12);
   // Without any same-source candidate: same heading (mic + source distance) wins over others.
-  const auto nb2 = nearest_training_rirs(set, {1, 2}, 0, 1, &d);
+  const auto nb2 = nearest_training_rirs(set, {1, 2}, set.rirs[0], 1, &d);
   ASSERT_EQ(nb2.size(), 1u);
   EXPECT_EQ(nb2[0], 2);
   EXPECT_NEAR(d[0], 0.2 + 1.0, 1e-12);
   // No same heading at all: the closest pose overall.
-  EXPECT_EQ(nearest_training_rirs(set, {1}, 0, 1)[0], 1);
+  EXPECT_EQ(nearest_training_rirs(set, {1}, set.rirs[0], 1)[0], 1);
 }
 
 TEST(AudioEval, RunFolderPredictsAndWritesJsonCsvPng) {
@@ -218,6 +218,26 @@ TEST(AudioEval, RunFolderPredictsAndWritesJsonCsvPng) {
   EXPECT_EQ(lines, 1 + 3 * 2);
   EXPECT_TRUE(fs::exists(o.out_dir + "/audio_00000.png"));
   EXPECT_NE(audio_table(e.methods).find("nearest"), std::string::npos);
+
+  // Any RIRs of a set in the same format (here: training RIRs, scored as if new): the same
+  // prediction as the default split's path gives for them, baselines from the run's train set.
+  const std::vector<int64_t> chosen = {rirs.train[0], rirs.train[1], rirs.train[2]};
+  const AudioEval n = evaluate_audio(ar, rirs, {rirs.train[3]}, rirs, chosen, o);
+  ASSERT_EQ(n.methods.size(), 3u);
+  EXPECT_EQ(n.rir_ids.size(), 3u);
+  EXPECT_EQ(n.rir_ids[1], rirs.rirs[static_cast<size_t>(chosen[1])].id);
+  EXPECT_EQ(to_json(n)["linear"]["n_rirs"], 3);
+  nlohmann::json manifest = make_audio_manifest(rirs);
+  EXPECT_NO_THROW(check_same_room_format(manifest, rirs, "novel"));
+  manifest["num_rirs"] = 1;  // another set of the same room: fine
+  EXPECT_NO_THROW(check_same_room_format(manifest, rirs, "novel"));
+  manifest["sample_rate"] = 48000;
+  try {
+    check_same_room_format(manifest, rirs, "novel");
+    ADD_FAILURE() << "a different sample rate must be refused";
+  } catch (const Error& err) {
+    EXPECT_NE(std::string(err.what()).find("sample_rate"), std::string::npos) << err.what();
+  }
 }
 
 TEST(AudioRun, VisionRunHasNoAcousticField) {

@@ -42,7 +42,9 @@ AcousticModelOptions acoustic_preset(const std::string& name, int64_t n_channels
     o.grid.cells_per_update = 1024;
     o.resnet = resnet3d_cpu_options();
     o.nacf = nacf_cpu_options(n_channels, n_freq, resnet3d_out_features(o.resnet));
-    o.nacf.bf16 = true;  // training follows --precision (train::audio_model_options)
+    o.nacf.bf16 = true;               // training follows --precision (train::audio_model_options)
+    o.nacf.relative_geometry = true;  // extent_m from the data (train::audio_model_options)
+    o.nacf.position_max_freq_exp = 1.0;  // room-scale positions (train_config.cpp says why)
   } else {
     throw Error("preset: unknown acoustic preset '" + name + "': use cpu or paper");
   }
@@ -81,7 +83,11 @@ torch::Tensor AcousticModelImpl::forward_with_feature(const torch::Tensor& featu
                                                       const torch::Tensor& mic_norm,
                                                       const torch::Tensor& src_norm,
                                                       const torch::Tensor& rot) {
-  const auto h = nacf_input(feature, t, options_.max_len, mic_norm, src_norm, rot);
+  const NacfOptions& o = options_.nacf;
+  auto h = nacf_input(feature, t, options_.max_len, mic_norm, src_norm, rot,
+                      o.position_max_freq_exp);  // [B, G + 163]
+  if (o.relative_geometry)
+    h = torch::cat({h, encode_relative_geometry(mic_norm, src_norm, rot, o.extent_m)}, 1);
   return field_->forward(h);  // [B, C, F]
 }
 

@@ -11,8 +11,8 @@
 //
 // Presets (acoustic_preset): "paper" = grid 128³, ResNet3D-50/layer3 (1024 features), NAcF
 // 1187→5096→2048→1024→1024→512, 4096 cells per grid update; "cpu" = grid 32³ with 1024 cells per
-// update, small BasicBlock ResNet3D (256 features), NAcF 5×512 (the paper's text), bf16 trunk
-// matrix products.
+// update, small BasicBlock ResNet3D (256 features), NAcF 5×512 (the paper's text) with the
+// relative-geometry inputs (nacf.h), bf16 trunk matrix products.
 #include <torch/nn/module.h>
 #include <torch/nn/pimpl.h>
 #include <torch/types.h>

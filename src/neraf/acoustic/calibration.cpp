@@ -2,6 +2,8 @@
 
 #include <torch/torch.h>
 
+#include <algorithm>
+
 namespace neraf::acoustic {
 
 namespace {
@@ -30,6 +32,21 @@ torch::Tensor calibration_gain(const torch::Tensor& gt_energy, const torch::Tens
   const torch::Tensor both = (gt > 0) & (pred > 0);
   const torch::Tensor ratio = torch::where(both, gt / pred.clamp_min(1e-300), torch::ones_like(gt));
   return ratio.sqrt().clamp(1.0 / kMaxCalibrationGain, kMaxCalibrationGain).to(torch::kFloat32);
+}
+
+torch::Tensor with_early_balance(const torch::Tensor& gain, const torch::Tensor& delta_db,
+                                 int64_t hop, int64_t split_sample) {
+  TORCH_CHECK(gain.dim() == 3 && delta_db.dim() == 1 && delta_db.size(0) == gain.size(0),
+              "with_early_balance: expected gain [C, F, T] and delta [C], got ", gain.sizes(),
+              " and ", delta_db.sizes());
+  TORCH_CHECK(hop > 0, "with_early_balance: hop must be positive");
+  const int64_t early = std::min(gain.size(2), (split_sample + hop - 1) / hop);  // t·hop < split
+  torch::Tensor factor = torch::ones({gain.size(0), 1, gain.size(2)}, torch::kFloat64);
+  factor.slice(2, 0, early)
+      .copy_(torch::pow(10.0, delta_db.to(torch::kFloat64) / 20.0).view({-1, 1, 1}));
+  return (gain.to(torch::kFloat64) * factor)
+      .clamp(1.0 / kMaxCalibrationGain, kMaxCalibrationGain)
+      .to(torch::kFloat32);
 }
 
 torch::Tensor apply_calibration(const torch::Tensor& log_stft, const torch::Tensor& gain) {

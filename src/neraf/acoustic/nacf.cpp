@@ -2,6 +2,8 @@
 
 #include <torch/torch.h>
 
+#include <cmath>
+
 #include "neraf/acoustic/positional_encoding.h"
 #include "neraf/nerf/sh_encoding.h"
 #include "neraf/util/error.h"
@@ -32,9 +34,10 @@ NerfEncodingOptions time_encoding() {
   return o;
 }
 
-NerfEncodingOptions position_encoding() {
+NerfEncodingOptions position_encoding(double max_freq_exp) {
   NerfEncodingOptions o;
   o.in_dim = 3;
+  o.max_freq_exp = max_freq_exp;
   return o;
 }
 
@@ -51,9 +54,10 @@ torch::Tensor encode_time(const torch::Tensor& t, int64_t max_len) {
   return nerf_encode(x, time_encoding());
 }
 
-torch::Tensor encode_position(const torch::Tensor& p_norm) {
+torch::Tensor encode_position(const torch::Tensor& p_norm, double max_freq_exp) {
   check_pose_batch(p_norm, "position");
-  return nerf_encode(p_norm.to(torch::kFloat64), position_encoding()).to(torch::kFloat32);
+  return nerf_encode(p_norm.to(torch::kFloat64), position_encoding(max_freq_exp))
+      .to(torch::kFloat32);
 }
 
 torch::Tensor encode_rot(const torch::Tensor& rot) {
@@ -61,17 +65,52 @@ torch::Tensor encode_rot(const torch::Tensor& rot) {
   return nerf::sh_encode_tcnn_input(rot.to(torch::kFloat64), 4).to(torch::kFloat32);
 }
 
+torch::Tensor encode_relative_geometry(const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
+                                       const torch::Tensor& rot,
+                                       const std::array<double, 3>& extent_m) {
+  check_pose_batch(mic_norm, "mic");
+  check_pose_batch(src_norm, "source");
+  check_pose_batch(rot, "rot");
+  const auto f64 = torch::TensorOptions().dtype(torch::kFloat64).device(mic_norm.device());
+  const auto extent = torch::tensor({extent_m[0], extent_m[1], extent_m[2]}, f64);
+  const auto d = (src_norm.to(torch::kFloat64) - mic_norm.to(torch::kFloat64)) * extent;  // [B,3]
+  const auto dx = d.select(1, 0), dy = d.select(1, 1), dz = d.select(1, 2);               // [B]
+  const auto dist = d.norm(2, 1).clamp_min(0.05);
+  const auto horizontal = (dx * dx + dz * dz).sqrt();
+  const auto r = rot.to(torch::kFloat64);
+  const auto heading = torch::atan2(2 * r.select(1, 2) - 1, 2 * r.select(1, 0) - 1);
+  const auto azimuth = torch::atan2(dz, dx);
+  std::vector<torch::Tensor> out;
+  for (int k = 1; k <= 3; ++k)
+    for (const auto& angle : {azimuth - heading, azimuth + heading}) {
+      out.push_back(torch::cos(k * angle));
+      out.push_back(torch::sin(k * angle));
+    }
+  out.push_back(dy / dist);
+  out.push_back(horizontal / dist);
+  const double diagonal =
+      std::sqrt(extent_m[0] * extent_m[0] + extent_m[1] * extent_m[1] + extent_m[2] * extent_m[2]);
+  const auto relative_dist = dist / diagonal;
+  out.push_back(relative_dist);
+  out.push_back(dist.log());
+  for (int k = 0; k < 3; ++k) {
+    out.push_back(torch::sin(2 * M_PI * std::ldexp(1.0, k) * relative_dist));
+    out.push_back(torch::cos(2 * M_PI * std::ldexp(1.0, k) * relative_dist));
+  }
+  return torch::stack(out, 1).to(torch::kFloat32);  // [B, 22]
+}
+
 torch::Tensor nacf_input(const torch::Tensor& grid_feature, const torch::Tensor& t, int64_t max_len,
                          const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
-                         const torch::Tensor& rot) {
+                         const torch::Tensor& rot, double position_max_freq_exp) {
   const int64_t b = t.size(0);
   TORCH_CHECK(mic_norm.size(0) == b && src_norm.size(0) == b && rot.size(0) == b,
               "nacf_input: batch sizes differ (t ", b, ", mic ", mic_norm.size(0), ", src ",
               src_norm.size(0), ", rot ", rot.size(0), ")");
-  const auto time = encode_time(t, max_len);   // [B, 21]
-  const auto mic = encode_position(mic_norm);  // [B, 63]
-  const auto src = encode_position(src_norm);  // [B, 63]
-  const auto r = encode_rot(rot);              // [B, 16]
+  const auto time = encode_time(t, max_len);                          // [B, 21]
+  const auto mic = encode_position(mic_norm, position_max_freq_exp);  // [B, 63]
+  const auto src = encode_position(src_norm, position_max_freq_exp);  // [B, 63]
+  const auto r = encode_rot(rot);                                     // [B, 16]
   if (!grid_feature.defined()) return torch::cat({mic, src, time, r}, 1);
   auto g = grid_feature.dim() == 1 ? grid_feature.unsqueeze(0) : grid_feature;  // [1|B, G]
   TORCH_CHECK(g.dim() == 2 && (g.size(0) == 1 || g.size(0) == b),

@@ -18,6 +18,13 @@
 // (5096 is what the published code trains), preset cpu 5×512 (the paper's text). Heads: one
 // Linear(W→F) per channel, out = 10·tanh(h), stacked [B, C, F]. PyTorch default Linear init.
 //
+// Relative geometry (ours; `cpu` preset on, `paper` off): the reference gives NAcF absolute
+// positions only, so the direction and distance of the source as the listener hears it (what sets
+// the arrival time, the direct level and the interaural differences) must be learned from a few
+// dozen training positions, and held-out headings and off-grid positions generalise poorly
+// (AV-NeRF's coordinate transformation makes the same point). With `relative_geometry` the input
+// gains kRelativeGeometryDim features after the reference's 163 + G (encode_relative_geometry).
+//
 // Precision: with `bf16` the trunk's matrix products run in bfloat16 (inputs and weights cast per
 // call, fp32 master weights, fp32 gradients), activations between trunk layers stay bf16; the heads
 // stay fp32 (0.6 % of the FLOPs) so the output is not rounded to bf16's 8-bit mantissa.
@@ -27,6 +34,7 @@
 #include <torch/nn/pimpl.h>
 #include <torch/types.h>
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -38,6 +46,7 @@ constexpr int64_t kRotEncodingDim = 16;
 // Everything but the grid feature: 21 + 63 + 63 + 16.
 constexpr int64_t kPoseEncodingDim =
     kTimeEncodingDim + 2 * kPositionEncodingDim + kRotEncodingDim;  // 163
+constexpr int64_t kRelativeGeometryDim = 22;
 
 struct NacfOptions {
   int64_t grid_features = 1024;  // G; 0 = no grid (ablation: reference order mic, src, time, rot)
@@ -45,10 +54,15 @@ struct NacfOptions {
   int64_t n_channels = 2;  // C: 2 SoundSpaces binaural, 1 RAF mono
   int64_t n_freq = 257;    // F: 257 SoundSpaces (n_fft 512), 513 RAF (n_fft 1024)
   double leaky_slope = 0.1;
-  double output_scale = 10.0;  // out = output_scale·tanh(h)
-  bool bf16 = false;           // bf16 trunk matrix products (fp32 master weights)
+  double output_scale = 10.0;               // out = output_scale·tanh(h)
+  bool bf16 = false;                        // bf16 trunk matrix products (fp32 master weights)
+  bool relative_geometry = false;           // append encode_relative_geometry (ours)
+  double position_max_freq_exp = 8.0;       // mic/source NeRFEncoding (reference 8)
+  std::array<double, 3> extent_m{1, 1, 1};  // audio aabb size (m): undoes the normalisation
 
-  int64_t in_features() const { return grid_features + kPoseEncodingDim; }
+  int64_t in_features() const {
+    return grid_features + kPoseEncodingDim + (relative_geometry ? kRelativeGeometryDim : 0);
+  }
 };
 
 NacfOptions nacf_paper_options(int64_t n_channels, int64_t n_freq, int64_t grid_features = 1024);
@@ -56,8 +70,23 @@ NacfOptions nacf_cpu_options(int64_t n_channels, int64_t n_freq, int64_t grid_fe
 
 // The three encodings, each [B, dim] float32.
 torch::Tensor encode_time(const torch::Tensor& t, int64_t max_len);  // t: [B] int → [B, 21]
-torch::Tensor encode_position(const torch::Tensor& p_norm);          // [B, 3] → [B, 63]
-torch::Tensor encode_rot(const torch::Tensor& rot);                  // [B, 3] → [B, 16]
+// [B, 3] → [B, 63]; max_freq_exp: the highest frequency exponent (reference 8: 2^8 cycles across
+// the audio box).
+torch::Tensor encode_position(const torch::Tensor& p_norm, double max_freq_exp = 8.0);
+torch::Tensor encode_rot(const torch::Tensor& rot);  // [B, 3] → [B, 16]
+
+// The source as heard from the microphone (y up), from the normalised positions, the audio aabb
+// size extent_m (so d = (src − mic)·extent is in metres) and the stored orientation (heading θ
+// from cosθ = 2·rot0 − 1, sinθ = 2·rot2 − 1). With φ the azimuth of d in the x-z plane:
+//   cos, sin of k(φ − θ) and of k(φ + θ), k = 1..3  (12: direction relative to the heading; both
+//       senses of rotation because datasets disagree on it, and a constant offset is linear in
+//       these; for a mono RAF set θ is the source's yaw, and φ + π its emission direction)
+//   d_y/|d|, d_xz/|d|                                (2: elevation)
+//   |d|/|extent|, ln(|d| / 1 m), sin, cos(2π·2^k·|d|/|extent|), k = 0..2  (8: distance)
+// → [B, 22] float32 (computed in float64). |d| is clamped to ≥ 5 cm.
+torch::Tensor encode_relative_geometry(const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
+                                       const torch::Tensor& rot,
+                                       const std::array<double, 3>& extent_m);
 
 // Builds the NAcF input [B, in_features] float32.
 //   grid_feature: [G] or [1, G] (broadcast to the batch) or [B, G]; undefined → no-grid layout.
@@ -66,7 +95,7 @@ torch::Tensor encode_rot(const torch::Tensor& rot);                  // [B, 3] �
 //   advised).
 torch::Tensor nacf_input(const torch::Tensor& grid_feature, const torch::Tensor& t, int64_t max_len,
                          const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
-                         const torch::Tensor& rot);
+                         const torch::Tensor& rot, double position_max_freq_exp = 8.0);
 
 class NacfImpl : public torch::nn::Module {
  public:

@@ -38,6 +38,7 @@ struct EvalArgs {
   bool skip_vision = false;
   int64_t max_rirs = -1;
   std::string ablation_runs;  // comma-separated run folders (e.g. trained with --grid none/zeros)
+  std::string novel_data;     // another dataset of the same room: every RIR is scored
 };
 
 std::vector<std::string> split_commas(const std::string& s) {
@@ -51,56 +52,99 @@ std::vector<std::string> split_commas(const std::string& s) {
   return out;
 }
 
-// The acoustic field on the test RIRs, with the nearest/linear baselines and optional ablation
-// runs (each a run folder of the same dataset; labelled "grid=<mode> (<folder>)").
-nlohmann::json evaluate_audio_json(const train::AudioRun& run, const EvalArgs& args) {
-  const std::string data_dir =
-      args.data.empty() ? run.run().manifest.at("data").get<std::string>() : args.data;
-  data::RirLoadOptions load;
-  load.progress = !args.quiet;
-  const data::RirSet rirs = data::load_rir_set(data_dir, load);
-  train::check_audio_manifest(run.run().manifest.at("audio"), rirs, data_dir);
-  train::AudioEvalOptions opts;
-  opts.progress = !args.quiet;
-  opts.max_rirs = args.max_rirs;
-  opts.baselines = !args.no_baselines;
-  opts.seed = run.run().config.seed;
-  opts.out_dir = args.images.empty() ? (std::filesystem::path(args.run) / "eval").string()
-                                     : args.images;
-  if (args.no_images) opts.num_images = 0;
-  const std::vector<int64_t> subset = train::audio_train_subset(
-      rirs, run.run().config.audio.fraction, run.run().config.seed);
-  train::AudioEval e = train::evaluate_audio(run, rirs, subset, opts);
+// The RIRs one audio table scores: `test` of `test_set`, baselines from `train_subset` of
+// `train_set` (the run's own dataset).
+struct AudioEvalSet {
+  const data::RirSet& train_set;
+  std::vector<int64_t> train_subset;
+  const data::RirSet& test_set;
+  std::vector<int64_t> test;
+};
+
+// The run, its baselines and the ablation runs on one set; prints the table under `title`, writes
+// the per-RIR CSV into opts.out_dir as `csv_name` → {"neraf", "nearest", "linear", "ablations"}.
+nlohmann::json score_audio(const train::AudioRun& run,
+                           const std::vector<std::pair<std::string, train::AudioRun>>& ablations,
+                           const AudioEvalSet& set, const train::AudioEvalOptions& opts,
+                           const std::string& csv_name, const std::string& title) {
+  train::AudioEval e =
+      train::evaluate_audio(run, set.train_set, set.train_subset, set.test_set, set.test, opts);
   nlohmann::json out = train::to_json(e);
-  std::vector<train::AudioMethodEval> table = e.methods;
-  if (!args.ablation_runs.empty()) {
+  if (!ablations.empty()) {
     nlohmann::json abl = nlohmann::json::object();
-    for (const std::string& dir : split_commas(args.ablation_runs)) {
-      const train::AudioRun other = train::load_audio_run(dir, torch::kCPU);
-      train::check_audio_manifest(other.run().manifest.at("audio"), rirs, dir + "/data.json");
-      std::vector<int64_t> test = rirs.test;
-      if (args.max_rirs >= 0 && static_cast<int64_t>(test.size()) > args.max_rirs)
-        test.resize(static_cast<size_t>(args.max_rirs));
-      train::AudioEvalOptions o = opts;
-      o.num_images = 0;
-      const std::string label = "grid=" + other.run().config.audio.grid + " (" +
-                                std::filesystem::path(dir).filename().string() + ")";
-      train::AudioMethodEval m = train::evaluate_audio_model(other, rirs, test, label, o);
+    train::AudioEvalOptions o = opts;
+    o.num_images = 0;
+    for (const auto& [dir, other] : ablations) {
+      const std::string label = std::filesystem::path(dir).filename().string();
+      train::AudioMethodEval m =
+          train::evaluate_audio_model(other, set.test_set, set.test, label, o);
       abl[label] = train::to_json(m.summary);
       abl[label]["run"] = dir;
-      e.methods.push_back(m);
-      table.push_back(m);
+      abl[label]["grid"] = other.run().config.audio.grid;
+      abl[label]["relative_geometry"] = other.run().config.audio.relative_geometry;
+      e.methods.push_back(std::move(m));
     }
     out["ablations"] = abl;
   }
-  const std::string csv = (std::filesystem::path(opts.out_dir) / "audio_per_rir.csv").string();
+  const std::string csv = (std::filesystem::path(opts.out_dir) / csv_name).string();
   std::filesystem::create_directories(opts.out_dir);
   train::write_audio_csv(csv, e);
-  out["grid"] = run.run().config.audio.grid;
   out["per_rir_csv"] = csv;
-  std::printf("audio (%s, %zu test RIRs, %.1f s; per-RIR CSV %s):\n%s",
-              data::to_string(rirs.layout), e.rir_ids.size(), e.seconds, csv.c_str(),
-              train::audio_table(table).c_str());
+  std::printf("%s (%s, %zu RIRs, %.1f s; per-RIR CSV %s):\n%s", title.c_str(),
+              data::to_string(set.test_set.layout), e.rir_ids.size(), e.seconds, csv.c_str(),
+              train::audio_table(e.methods).c_str());
+  return out;
+}
+
+data::RirSet load_rirs(const std::string& dir, bool progress) {
+  data::RirLoadOptions load;
+  load.progress = progress;
+  return data::load_rir_set(dir, load);
+}
+
+// The acoustic field on the test RIRs (and, with --novel-data, on every RIR of another dataset of
+// the same room), with the nearest/linear baselines and the ablation runs.
+nlohmann::json evaluate_audio_json(const train::AudioRun& run, const EvalArgs& args) {
+  const std::string data_dir =
+      args.data.empty() ? run.run().manifest.at("data").get<std::string>() : args.data;
+  const data::RirSet rirs = load_rirs(data_dir, !args.quiet);
+  train::check_audio_manifest(run.run().manifest.at("audio"), rirs, data_dir);
+  std::vector<std::pair<std::string, train::AudioRun>> ablations;
+  for (const std::string& dir : split_commas(args.ablation_runs)) {
+    ablations.emplace_back(dir, train::load_audio_run(dir, torch::kCPU));
+    train::check_audio_manifest(ablations.back().second.run().manifest.at("audio"), rirs,
+                                dir + "/data.json");
+  }
+  train::AudioEvalOptions opts;
+  opts.progress = !args.quiet;
+  opts.baselines = !args.no_baselines;
+  opts.seed = run.run().config.seed;
+  opts.out_dir =
+      args.images.empty() ? (std::filesystem::path(args.run) / "eval").string() : args.images;
+  if (args.no_images) opts.num_images = 0;
+  const std::vector<int64_t> subset =
+      train::audio_train_subset(rirs, run.run().config.audio.fraction, run.run().config.seed);
+
+  require(!rirs.test.empty(), data_dir + ": the audio test split is empty; nothing to evaluate");
+  std::vector<int64_t> test = rirs.test;
+  if (args.max_rirs >= 0 && static_cast<int64_t>(test.size()) > args.max_rirs)
+    test.resize(static_cast<size_t>(args.max_rirs));
+  nlohmann::json out = score_audio(run, ablations, {rirs, subset, rirs, test}, opts,
+                                   "audio_per_rir.csv", "audio, held-out test split");
+  out["grid"] = run.run().config.audio.grid;
+  if (!args.novel_data.empty()) {
+    const data::RirSet novel = load_rirs(args.novel_data, !args.quiet);
+    train::check_same_room_format(run.run().manifest.at("audio"), novel, args.novel_data);
+    std::vector<int64_t> all(novel.rirs.size());
+    for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
+    if (args.max_rirs >= 0 && static_cast<int64_t>(all.size()) > args.max_rirs)
+      all.resize(static_cast<size_t>(args.max_rirs));
+    opts.num_images = 0;
+    out["novel"] =
+        score_audio(run, ablations, {rirs, subset, novel, all}, opts, "audio_novel_per_rir.csv",
+                    "audio at new microphone positions (" + args.novel_data + ")");
+    out["novel"]["data"] = args.novel_data;
+  }
   return out;
 }
 
@@ -121,14 +165,12 @@ nlohmann::json evaluate_vision_json(train::LoadedRun& run, const EvalArgs& args)
   opts.max_views = args.max_views;
   opts.progress = !args.quiet;
   if (!args.no_images)
-    opts.image_dir = args.images.empty()
-                         ? (std::filesystem::path(args.run) / "eval").string()
-                         : args.images;
+    opts.image_dir =
+        args.images.empty() ? (std::filesystem::path(args.run) / "eval").string() : args.images;
   const train::VisionEval e = train::evaluate_vision(run.model, images.eval, opts);
   std::printf("vision: PSNR %.3f dB  SSIM %.4f  over %lld eval views (%.1f s)%s%s\n", e.psnr,
               e.ssim, static_cast<long long>(e.n_views), e.seconds,
-              opts.image_dir.empty() ? "" : "; GT|prediction images in ",
-              opts.image_dir.c_str());
+              opts.image_dir.empty() ? "" : "; GT|prediction images in ", opts.image_dir.c_str());
   return train::to_json(e);
 }
 
@@ -143,12 +185,15 @@ void register_eval(CLI::App& app) {
       "eval views). The JSON has {\"run\", \"checkpoint\", \"step\", \"vision\": {\"psnr\",\n"
       "\"ssim\", \"n_views\", \"views\": [...]}, \"audio\": {\"neraf\"|\"nearest\"|\"linear\":\n"
       "{\"t60_error_pct\", \"c50_error_db\", \"edt_error_s\", \"stft_error\", \"invalid_t60\",\n"
-      "\"n_rirs\", \"*_std\"}, \"ablations\"}}. Audio follows NeRAF's evaluator: predicted log-STFT\n"
+      "\"n_rirs\", \"*_std\"}, \"ablations\", \"novel\"}}. Audio follows NeRAF's evaluator: "
+      "predicted log-STFT\n"
       "→ Griffin-Lim (32 it., seeded) → T60/C50/EDT vs the measured waveform. Baselines:\n"
       "nearest = the measured RIR of the closest training mic with the same heading and source;\n"
       "linear = inverse-distance blend of the 2-4 closest such training RIRs' magnitudes +\n"
       "Griffin-Lim. Side-by-side GT | prediction PNGs (images: eval_*.png; audio: audio_*.png\n"
       "prediction | GT log-STFT) and audio_per_rir.csv go to RUN/eval/ (or --images DIR).\n"
+      "The test split holds out (source, heading) pairs at trained microphone positions;\n"
+      "--novel-data scores new positions too (audio.novel).\n"
       "Example: neraf eval --run runs/demo --json runs/demo/eval.json");
   cmd->add_option("--run", args->run, "Run folder made by neraf train")->required();
   cmd->add_option("--json", args->json, "Output JSON file")->required();
@@ -171,7 +216,12 @@ void register_eval(CLI::App& app) {
   cmd->add_option("--ablation-runs", args->ablation_runs,
                   "Audio: comma-separated run folders of the same dataset (e.g. trained with "
                   "--grid none / zeros) scored on the same test RIRs and added to the table "
-                  "and JSON (audio.ablations)");
+                  "and JSON (audio.ablations, labelled by folder name)");
+  cmd->add_option("--novel-data", args->novel_data,
+                  "Audio: another dataset of the same room (same layout and rates, e.g. "
+                  "`neraf synth --preset demo --mics random`): every RIR of it is scored as well, "
+                  "at microphone positions the run never saw (JSON audio.novel, "
+                  "audio_novel_per_rir.csv); the baselines still use the run's training RIRs");
   cmd->callback([args]() {
     if (args->threads > 0) torch::set_num_threads(args->threads);
     const std::string config_path = (std::filesystem::path(args->run) / "config.json").string();

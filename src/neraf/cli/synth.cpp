@@ -17,7 +17,8 @@ namespace neraf::cli {
 namespace {
 
 struct SynthArgs {
-  std::string scene_file, preset, layout = "soundspaces", out_dir, hrtf;
+  std::string scene_file, preset, layout = "soundspaces", out_dir, hrtf, mics;
+  int64_t mic_count = 0;
   uint64_t seed = 0;
   int threads = 0;
   bool force = false, quiet = false, print_scene = false, dry_run = false;
@@ -32,9 +33,11 @@ std::string preset_list() {
 void run_synth(const SynthArgs& a) {
   require(a.scene_file.empty() != a.preset.empty(),
           "synth: give exactly one of --scene FILE.json or --preset NAME (" + preset_list() + ")");
-  const sim::Scene scene =
-      a.preset.empty() ? sim::load_scene(a.scene_file) : sim::preset_scene(a.preset);
-  if (!a.preset.empty()) sim::validate_scene(scene, "preset " + a.preset);
+  sim::Scene scene = a.preset.empty() ? sim::load_scene(a.scene_file) : sim::preset_scene(a.preset);
+  if (!a.mics.empty()) scene.microphones.kind = a.mics;
+  if (a.mic_count > 0) scene.microphones.random.count = a.mic_count;
+  const std::string where = a.preset.empty() ? a.scene_file : "preset " + a.preset;
+  if (!a.preset.empty() || !a.mics.empty() || a.mic_count > 0) sim::validate_scene(scene, where);
   if (a.print_scene) {
     std::printf("%s\n", sim::scene_to_json(scene).dump(2).c_str());
     return;
@@ -101,6 +104,15 @@ void register_synth(CLI::App& app) {
                   "frame_ images split 90/10 by the reader)")
       ->check(CLI::IsMember({"soundspaces", "raf"}))
       ->capture_default_str();
+  cmd->add_option("--mics", args->mics,
+                  "Microphone placement instead of the scene's: grid (SoundSpaces-like regular "
+                  "grid) or random (the scene's microphones.random settings). The same room "
+                  "with random microphones tests a trained run at new positions: neraf eval "
+                  "--novel-data DIR")
+      ->check(CLI::IsMember({"grid", "random"}));
+  cmd->add_option("--mic-count", args->mic_count,
+                  "Number of random microphone positions (with --mics random)")
+      ->check(CLI::Range(1, 1000000));
   cmd->add_option("--out", args->out_dir, "Output folder (created; must be empty unless --force)");
   cmd->add_option("--seed", args->seed,
                   "Seed of every random choice (camera and random-microphone placement, splits, "

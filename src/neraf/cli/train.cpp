@@ -29,6 +29,7 @@ struct TrainArgs {
   double audio_fraction = 1.0;
   int64_t audio_start = -2;
   double decay_loss = 0;
+  bool no_relative_geometry = false;
   std::string preset = "cpu";
   int64_t steps = 0;
   uint64_t seed = 42;
@@ -112,6 +113,10 @@ void register_train(CLI::App& app) {
                       "Weight of the energy-decay loss on whole RIRs (the paper's \"++\" "
                       "variant; default 0 = off, as the reference)")
           ->check(CLI::NonNegativeNumber);
+  CLI::Option* no_relative = cmd->add_flag(
+      "--no-relative-geometry", args->no_relative_geometry,
+      "Give the acoustic field absolute positions only, as the reference does (the cpu "
+      "preset also gives it the source's direction and distance relative to the listener)");
   cmd->add_option("--out", args->out, "Run folder to create (or to resume)")->required();
   cmd->add_flag("--resume", args->resume,
                 "Continue the run in --out from its latest checkpoint (uses its config.json)");
@@ -120,7 +125,7 @@ void register_train(CLI::App& app) {
   cmd->add_flag("--quiet", args->quiet, "No progress bar");
 
   cmd->callback([args, data, preset, steps, seed, threads, rays, precision, grid, fraction,
-                 vision_run, audio_start, decay_loss]() {
+                 vision_run, audio_start, decay_loss, no_relative]() {
     require(!(args->resume && args->force), "--resume and --force: choose one");
     require(args->resume || data->count() > 0, "--data: required (the dataset folder)");
     train::TrainConfig cfg = train::train_preset(args->preset);
@@ -150,6 +155,7 @@ void register_train(CLI::App& app) {
     cfg.audio.grid = args->grid;
     if (decay_loss->count()) cfg.audio.decay_weight = args->decay_loss;
     cfg.audio.fraction = args->audio_fraction;
+    if (args->no_relative_geometry) cfg.audio.relative_geometry = false;
     if (vision_run->count())
       cfg.audio.vision_run =
           std::filesystem::absolute(args->vision_run).lexically_normal().string();
@@ -170,8 +176,8 @@ void register_train(CLI::App& app) {
     opts.progress = !args->quiet;
     if (args->resume) {
       // The run's own config wins; flags that would change the model are refused.
-      for (CLI::Option* o :
-           {preset, seed, rays, precision, grid, fraction, vision_run, audio_start, decay_loss})
+      for (CLI::Option* o : {preset, seed, rays, precision, grid, fraction, vision_run, audio_start,
+                             decay_loss, no_relative})
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json is "
                                      "used); start a new run with --out to change it");

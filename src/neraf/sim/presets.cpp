@@ -64,10 +64,11 @@ Scene demo() {
   s.microphones.grid.spacing_m = 0.55;
   s.microphones.grid.height_m = 1.5;
   s.microphones.grid.wall_margin_m = 0.5;
-  s.microphones.random.count = 150;
-  s.microphones.random.min_height_m = 0.9;
-  s.microphones.random.max_height_m = 1.8;
-  s.microphones.random.wall_margin_m = 0.3;
+  // `--mics random`: new positions in the grid's plane and box, to test a run trained on the grid.
+  s.microphones.random.count = 50;
+  s.microphones.random.min_height_m = 1.5;
+  s.microphones.random.max_height_m = 1.5;
+  s.microphones.random.wall_margin_m = 0.5;
   s.cameras.train_count = 50;
   s.cameras.eval_count = 10;
   s.cameras.width = s.cameras.height = 96;

@@ -7,6 +7,7 @@
 
 #include "neraf/acoustic/calibration.h"
 #include "neraf/acoustic/losses.h"
+#include "neraf/metrics/room_acoustics.h"
 #include "neraf/train/audio_run.h"
 #include "neraf/train/checkpoint.h"
 #include "neraf/util/error.h"
@@ -14,7 +15,8 @@
 namespace neraf::train {
 
 acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, int64_t channels,
-                                                   int64_t n_freq, int64_t max_len) {
+                                                   int64_t n_freq, int64_t max_len,
+                                                   const data::Aabb& audio_aabb) {
   acoustic::AcousticModelOptions o =
       acoustic::acoustic_preset(config.preset, channels, n_freq, max_len);
   const AudioConfig& a = config.audio;
@@ -24,6 +26,11 @@ acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, in
   if (a.nacf_width > 0) o.nacf.trunk.assign(static_cast<size_t>(a.nacf_layers), a.nacf_width);
   // The NAcF trunk follows --precision, as the radiance field's MLPs.
   o.nacf.bf16 = config.model.precision == nerf::Precision::bf16;
+  o.nacf.relative_geometry = a.relative_geometry;
+  o.nacf.position_max_freq_exp = a.position_max_freq_exp;
+  const geometry::Vec3& lo = audio_aabb.min;
+  const geometry::Vec3& hi = audio_aabb.max;
+  o.nacf.extent_m = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
   return o;
 }
 
@@ -54,7 +61,7 @@ AudioBranch::AudioBranch(const TrainConfig& config, const data::RirSet& rirs,
           "dataset: the audio train split is empty; the acoustic field "
           "needs training RIRs");
   const acoustic::AcousticModelOptions opts =
-      audio_model_options(config_, rirs_.channels, rirs_.n_freq, rirs_.max_len);
+      audio_model_options(config_, rirs_.channels, rirs_.n_freq, rirs_.max_len, rirs_.audio_aabb);
   model_ = acoustic::AcousticModel(opts);
   model_->to(device_);
   grid_ = acoustic::GridSampler(opts.grid);
@@ -189,8 +196,11 @@ torch::Tensor AudioBranch::energy_calibration() {
   const torch::Tensor feature = model_->scene_feature(grid_->grid().detach());  // [G] or none
   const int64_t n = static_cast<int64_t>(train_rirs_.size());
   const int64_t stride = std::max<int64_t>(1, (n + 511) / 512);  // at most 512 RIRs
+  const int64_t sampled = (n + stride - 1) / stride;
+  const int64_t balance_stride = std::max<int64_t>(1, (sampled + 63) / 64);  // ≤ 64 of those
   torch::Tensor gt_energy = torch::zeros({C, F, T}, torch::kFloat64),
                 pred_energy = gt_energy.clone();
+  std::vector<std::pair<int64_t, torch::Tensor>> preds;  // (RIR, [C, F, T]) for the balance
   for (int64_t k = 0; k < n; k += stride) {
     const int64_t i = train_rirs_[static_cast<size_t>(k)];
     const torch::Tensor idx = torch::tensor({i}, torch::kInt64);
@@ -202,9 +212,36 @@ torch::Tensor AudioBranch::energy_calibration() {
         feature, mic.to(device_), src.to(device_), rirs_.rots[i].to(device_));  // [C, F, T]
     pred_energy += acoustic::bin_energy(pred.cpu());
     gt_energy += acoustic::bin_energy(rirs_.features(i));
+    if ((k / stride) % balance_stride == 0) preds.emplace_back(i, pred.cpu());
   }
   model_->train(was_training);
-  return acoustic::calibration_gain(gt_energy, pred_energy);
+  const torch::Tensor gain = acoustic::calibration_gain(gt_energy, pred_energy);
+
+  // Early/late balance: C50 of the calibrated predictions rendered as evaluation renders them
+  // (Griffin-Lim, seeded) against the training waveforms, per channel (calibration.h).
+  const double fs = rirs_.sample_rate;
+  torch::Tensor delta = torch::zeros({C}, torch::kFloat64);
+  std::vector<int64_t> counted(static_cast<size_t>(C), 0);
+  for (size_t r = 0; r < preds.size(); ++r) {
+    const auto& [i, pred] = preds[r];
+    const torch::Tensor gt = rirs_.waveform(i).contiguous();  // [C, L]
+    const auto wave =
+        griffin_lim_channels(log_stft_to_magnitude(acoustic::apply_calibration(pred, gain)),
+                             rirs_.stft, config_.seed + r, gt.size(1));
+    for (int64_t c = 0; c < C; ++c) {
+      const float* g = gt[c].data_ptr<float>();
+      const double d = metrics::measure_c50(std::vector<float>(g, g + gt.size(1)), fs) -
+                       metrics::measure_c50(wave[static_cast<size_t>(c)], fs);
+      if (!std::isfinite(d)) continue;
+      delta[c] += d;
+      ++counted[static_cast<size_t>(c)];
+    }
+  }
+  for (int64_t c = 0; c < C; ++c)
+    if (counted[static_cast<size_t>(c)] > 0)
+      delta[c] /= static_cast<double>(counted[static_cast<size_t>(c)]);
+  return acoustic::with_early_balance(gain, delta, rirs_.stft.hop_length,
+                                      metrics::c50_split_sample(fs));
 }
 
 void AudioBranch::save(torch::serialize::OutputArchive& archive) {

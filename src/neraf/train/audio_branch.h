@@ -32,9 +32,11 @@
 namespace neraf::train {
 
 // The acoustic model options of a run: the preset's (`config.preset`) sized to the data, with the
-// AudioConfig overrides (grid mode, resolution, cells per update, NAcF width).
+// AudioConfig overrides (grid mode, resolution, cells per update, NAcF width, relative geometry
+// in the metres of `audio_aabb`).
 acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, int64_t channels,
-                                                   int64_t n_freq, int64_t max_len);
+                                                   int64_t n_freq, int64_t max_len,
+                                                   const data::Aabb& audio_aabb);
 
 // The seeded subset of `rirs.train` used for training (--audio-fraction): all of it for
 // fraction 1, else round(fraction·N) (at least 1) indices drawn without replacement with `seed`,

@@ -56,17 +56,15 @@ std::vector<int64_t> test_indices(const data::RirSet& rirs, int64_t max_rirs) {
 
 }  // namespace
 
-std::vector<int64_t> nearest_training_rirs(const data::RirSet& rirs,
-                                           const std::vector<int64_t>& train, int64_t query,
+std::vector<int64_t> nearest_training_rirs(const data::RirSet& train_set,
+                                           const std::vector<int64_t>& train, const data::Rir& q,
                                            int64_t k, std::vector<double>* dist) {
-  const data::Rir& q = rirs.rirs.at(static_cast<size_t>(query));
   // Tier 0: same heading and source; tier 1: same heading; tier 2: anything. The first
   // non-empty tier is used.
   for (int tier = 0; tier < 3; ++tier) {
     std::vector<std::pair<double, int64_t>> cand;
     for (int64_t i : train) {
-      if (i == query) continue;
-      const data::Rir& r = rirs.rirs.at(static_cast<size_t>(i));
+      const data::Rir& r = train_set.rirs.at(static_cast<size_t>(i));
       const bool same_heading = r.heading_deg == q.heading_deg;
       const double ds = dist3(r.source, q.source);
       const bool same_source = ds < 1e-3;
@@ -125,30 +123,37 @@ AudioMethodEval evaluate_audio_model(const AudioRun& run, const data::RirSet& ri
 AudioEval evaluate_audio(const AudioRun& run, const data::RirSet& rirs,
                          const std::vector<int64_t>& train_subset,
                          const AudioEvalOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
   require(!rirs.test.empty(), rirs.root + ": the audio test split is empty; nothing to evaluate");
+  return evaluate_audio(run, rirs, train_subset, rirs, test_indices(rirs, options.max_rirs),
+                        options);
+}
+
+AudioEval evaluate_audio(const AudioRun& run, const data::RirSet& train_set,
+                         const std::vector<int64_t>& train_subset, const data::RirSet& test_set,
+                         const std::vector<int64_t>& test, const AudioEvalOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  require(!test.empty(), test_set.root + ": no RIRs to evaluate");
   AudioEval e;
-  const std::vector<int64_t> test = test_indices(rirs, options.max_rirs);
-  for (int64_t i : test) e.rir_ids.push_back(rirs.rirs[static_cast<size_t>(i)].id);
+  for (int64_t i : test) e.rir_ids.push_back(test_set.rirs[static_cast<size_t>(i)].id);
   if (!options.out_dir.empty()) fs::create_directories(options.out_dir);
-  e.methods.push_back(evaluate_audio_model(run, rirs, test, "neraf", options));
+  e.methods.push_back(evaluate_audio_model(run, test_set, test, "neraf", options));
 
   if (options.baselines) {
     require(!train_subset.empty(), "baselines: no training RIRs");
-    const metrics::Variant variant = variant_of(rirs);
+    const metrics::Variant variant = variant_of(test_set);
     AudioMethodEval nearest{"nearest", {}, {}}, linear{"linear", {}, {}};
     Progress progress("eval audio (baselines)", static_cast<int64_t>(test.size()),
                       ProgressOptions{"RIR", 0.2, 10.0, options.progress});
     for (size_t n = 0; n < test.size(); ++n) {
       const int64_t i = test[n];
-      const io::AudioBuffer gt = tensor_buffer(rirs.waveform(i), rirs.sample_rate);
+      const data::Rir& query = test_set.rirs[static_cast<size_t>(i)];
+      const io::AudioBuffer gt = tensor_buffer(test_set.waveform(i), test_set.sample_rate);
       std::vector<double> d;
-      const std::vector<int64_t> nb = nearest_training_rirs(rirs, train_subset, i, 4, &d);
+      const std::vector<int64_t> nb = nearest_training_rirs(train_set, train_subset, query, 4, &d);
       // nearest: the neighbour's measured waveform.
-      nearest.per_rir.push_back(
-          metrics::compare_rirs(tensor_buffer(rirs.waveform(nb[0]), rirs.sample_rate), gt, variant,
-                                "nearest " + rirs.rirs[static_cast<size_t>(nb[0])].id,
-                                rirs.rirs[static_cast<size_t>(i)].id));
+      nearest.per_rir.push_back(metrics::compare_rirs(
+          tensor_buffer(train_set.waveform(nb[0]), train_set.sample_rate), gt, variant,
+          "nearest " + train_set.rirs[static_cast<size_t>(nb[0])].id, query.id));
       // linear: inverse-distance-weighted magnitude blend, then Griffin-Lim.
       std::vector<double> w(nb.size());
       if (d[0] < 1e-6) {
@@ -160,13 +165,12 @@ AudioEval evaluate_audio(const AudioRun& run, const data::RirSet& rirs,
       const double wsum = std::accumulate(w.begin(), w.end(), 0.0);
       torch::Tensor mag;
       for (size_t j = 0; j < nb.size(); ++j) {
-        const torch::Tensor mj = log_stft_to_magnitude(rirs.features(nb[j])) * (w[j] / wsum);
+        const torch::Tensor mj = log_stft_to_magnitude(train_set.features(nb[j])) * (w[j] / wsum);
         mag = mag.defined() ? mag + mj : mj;
       }
-      const auto wave = griffin_lim_channels(mag, rirs.stft, options.seed + n);
-      linear.per_rir.push_back(metrics::compare_rirs(to_buffer(wave, rirs.sample_rate), gt, variant,
-                                                     "linear",
-                                                     rirs.rirs[static_cast<size_t>(i)].id));
+      const auto wave = griffin_lim_channels(mag, train_set.stft, options.seed + n);
+      linear.per_rir.push_back(metrics::compare_rirs(to_buffer(wave, test_set.sample_rate), gt,
+                                                     variant, "linear", query.id));
       progress.update(static_cast<int64_t>(n) + 1);
     }
     progress.finish();
@@ -222,12 +226,12 @@ void write_audio_csv(const std::string& path, const AudioEval& e) {
 std::string audio_table(const std::vector<AudioMethodEval>& methods) {
   std::ostringstream out;
   char buf[200];
-  std::snprintf(buf, sizeof buf, "%-22s %10s %10s %10s %10s %9s %6s\n", "method", "T60 (%)",
+  std::snprintf(buf, sizeof buf, "%-28s %10s %10s %10s %10s %9s %6s\n", "method", "T60 (%)",
                 "C50 (dB)", "EDT (s)", "STFT err", "invalid", "n");
   out << buf;
   for (const auto& m : methods) {
     const auto& s = m.summary;
-    std::snprintf(buf, sizeof buf, "%-22s %10.3f %10.4f %10.5f %10.4f %9.3f %6zu\n", m.name.c_str(),
+    std::snprintf(buf, sizeof buf, "%-28s %10.3f %10.4f %10.5f %10.4f %9.3f %6zu\n", m.name.c_str(),
                   s.t60_error_pct.mean, s.c50_error_db.mean, s.edt_error_s.mean, s.stft_error.mean,
                   s.invalid_t60.mean, s.count);
     out << buf;

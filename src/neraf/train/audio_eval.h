@@ -29,11 +29,12 @@
 
 namespace neraf::train {
 
-// Candidate training RIRs for test RIR `query`, ordered by distance (closest first), at most `k`
-// (k ≤ 0: all). `train` are indices into rirs.rirs. Distances in `dist` (metres).
-std::vector<int64_t> nearest_training_rirs(const data::RirSet& rirs,
-                                           const std::vector<int64_t>& train, int64_t query,
-                                           int64_t k, std::vector<double>* dist = nullptr);
+// Candidate training RIRs for the pose of `query`, ordered by distance (closest first), at most
+// `k` (k ≤ 0: all). `train` are indices into train_set.rirs. Distances in `dist` (metres).
+std::vector<int64_t> nearest_training_rirs(const data::RirSet& train_set,
+                                           const std::vector<int64_t>& train,
+                                           const data::Rir& query, int64_t k,
+                                           std::vector<double>* dist = nullptr);
 
 struct AudioEvalOptions {
   std::string out_dir;     // per-RIR CSV (audio_per_rir.csv) and PNGs (audio_XXX.png) here
@@ -57,9 +58,15 @@ struct AudioEval {
 };
 
 // `train_subset`: the training RIRs the baselines may use (the run's --audio-fraction subset).
+// Scores rirs.test (the first options.max_rirs of it).
 AudioEval evaluate_audio(const AudioRun& run, const data::RirSet& rirs,
                          const std::vector<int64_t>& train_subset,
                          const AudioEvalOptions& options = {});
+// Same for the RIRs `test` of another set of the same room (new microphone positions, e.g.
+// `neraf synth --mics random`); the baselines draw on `train_subset` of `train_set`.
+AudioEval evaluate_audio(const AudioRun& run, const data::RirSet& train_set,
+                         const std::vector<int64_t>& train_subset, const data::RirSet& test_set,
+                         const std::vector<int64_t>& test, const AudioEvalOptions& options = {});
 // neraf only (for ablation runs): method named `label`.
 AudioMethodEval evaluate_audio_model(const AudioRun& run, const data::RirSet& rirs,
                                      const std::vector<int64_t>& test, const std::string& label,

@@ -103,6 +103,17 @@ void check_audio_manifest(const nlohmann::json& manifest, const data::RirSet& ri
                 now[key].dump() + "); use the original --data or a new --out folder");
 }
 
+void check_same_room_format(const nlohmann::json& manifest, const data::RirSet& rirs,
+                            const std::string& where) {
+  const nlohmann::json now = make_audio_manifest(rirs);
+  for (const char* key : {"layout", "sample_rate", "channels", "n_fft", "win_length", "hop_length",
+                          "n_freq", "max_len", "waveform_length"})
+    require(manifest.value(key, nlohmann::json()) == now[key],
+            where + ": its " + key + " (" + now[key].dump() + ") differs from the run's (" +
+                manifest.value(key, nlohmann::json()).dump() +
+                "); synthesise or convert it in the run's format");
+}
+
 std::vector<std::vector<float>> griffin_lim_channels(const torch::Tensor& magnitude,
                                                      const dsp::StftParams& stft, uint64_t seed,
                                                      int64_t length) {
@@ -194,7 +205,7 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
   }
   const AudioRunInfo& info = out.info_;
   const acoustic::AcousticModelOptions opts =
-      audio_model_options(out.run_.config, info.channels, info.n_freq, info.max_len);
+      audio_model_options(out.run_.config, info.channels, info.n_freq, info.max_len, info.aabb);
   out.model_ = acoustic::AcousticModel(opts);
   acoustic::GridSampler grid(opts.grid);
   torch::serialize::InputArchive a;

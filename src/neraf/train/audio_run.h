@@ -51,6 +51,10 @@ AudioRunInfo audio_info_from_manifest(const nlohmann::json& audio, const std::st
 // neraf::Error "<where>: ... differs (key)" when `rirs` is not the dataset of `manifest`.
 void check_audio_manifest(const nlohmann::json& manifest, const data::RirSet& rirs,
                           const std::string& where);
+// neraf::Error when `rirs` cannot be scored against the run of `manifest`: another layout, sample
+// rate, channel count or STFT (any set of the same room in the same format passes).
+void check_same_room_format(const nlohmann::json& manifest, const data::RirSet& rirs,
+                            const std::string& where);
 
 // mag = clip(exp(log_stft) − 1e-3, 0, 1e4) (neraf-reference.md §4.1). Any shape.
 using acoustic::log_stft_to_magnitude;

@@ -61,6 +61,11 @@ struct AudioConfig {
   // Per-frame energy gains fitted on the train RIRs, applied at inference (ours, off in the
   // paper preset; acoustic/calibration.h).
   bool energy_calibration = true;
+  // NAcF also sees the source's direction and distance relative to the listener (ours, off in the
+  // paper preset; acoustic/nacf.h, encode_relative_geometry).
+  bool relative_geometry = true;
+  // Highest frequency exponent of the mic/source position encoding (reference 8).
+  double position_max_freq_exp = 8.0;
   std::string vision_run;  // modality audio: the finished vision run whose field is frozen
   // "audio_fields" group: NAcF + ResNet3D (+ the radiance field in joint mode), Adam eps 1e-15,
   // sine warm-up from 1e-8 over warmup_steps then log-linear decay (neraf-reference.md §2.3).
@@ -81,6 +86,8 @@ struct AudioConfig {
     v("early_fraction", early_fraction);
     v("early_frames", early_frames);
     v("energy_calibration", energy_calibration);
+    v("relative_geometry", relative_geometry);
+    v("position_max_freq_exp", position_max_freq_exp);
     v("vision_run", vision_run);
     v("schedule", schedule);
   }
