@@ -146,6 +146,10 @@ void register_train(CLI::App& app) {
     // joint runs keep 3000, as the acoustic field starts at step 1000.
     if (cfg.modality == train::Modality::vision && !paper) train::set_run_length(cfg, 2000);
     if (steps->count()) train::set_run_length(cfg, args->steps);
+    if (cfg.modality == train::Modality::audio) {  // a short run still gets a (shorter) warm-up
+      auto& schedule = cfg.audio.schedule;
+      schedule.warmup_steps = std::min(schedule.warmup_steps, schedule.max_steps / 2);
+    }
     cfg.seed = args->seed;
     if (audio_start->count()) {
       if (cfg.audio.schedule.warmup_steps == cfg.audio.start_step)  // warm-up ends at the start
