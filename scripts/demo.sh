@@ -27,8 +27,8 @@ $NERAF synth --preset demo --layout soundspaces --mics random --out "$OUT/novel"
 step "2/6 train the radiance and acoustic fields jointly (cpu preset)"
 $NERAF train --data "$OUT/scene" --out "$OUT/run" --force
 # Ablations, each the acoustic field alone on the joint run's frozen field (2000 steps, as many
-# audio steps as the joint run): the paper's no-grid and all-zero-grid, and absolute positions
-# only (the reference's NAcF input).
+# audio steps as the joint run): the paper's no-grid and all-zero-grid, and without the
+# relative-geometry inputs (absolute positions only, as the reference's NAcF gets them).
 for grid in none zeros; do
   $NERAF train --data "$OUT/scene" --modality audio --vision-run "$OUT/run" --grid $grid \
     --steps 2000 --out "$OUT/ablation_grid_$grid" --force
