@@ -48,6 +48,8 @@ expect_file "$R/eval/audio_novel_per_rir.csv"
 expect_exit 0 "$NERAF" synth --preset demo --layout raf --out "$TMP/raf" --seed 4 --quiet
 expect_exit 1 "$NERAF" eval --run "$R" --json "$TMP/x.json" --skip-vision --novel-data "$TMP/raf"
 expect_in "$TMP/err" "differs from the run's"
+expect_exit 1 "$NERAF" synth --preset demo --mic-count 3 --out "$TMP/x" --quiet
+expect_in "$TMP/err" "--mics random"
 expect_exit 1 "$NERAF" eval --run "$TMP/no-such-run" --json "$TMP/x.json"
 expect_in "$TMP/err" "no-such-run"
 

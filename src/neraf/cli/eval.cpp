@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <numeric>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -126,23 +128,27 @@ nlohmann::json evaluate_audio_json(const train::AudioRun& run, const EvalArgs& a
       train::audio_train_subset(rirs, run.run().config.audio.fraction, run.run().config.seed);
 
   require(!rirs.test.empty(), data_dir + ": the audio test split is empty; nothing to evaluate");
-  std::vector<int64_t> test = rirs.test;
-  if (args.max_rirs >= 0 && static_cast<int64_t>(test.size()) > args.max_rirs)
-    test.resize(static_cast<size_t>(args.max_rirs));
-  nlohmann::json out = score_audio(run, ablations, {rirs, subset, rirs, test}, opts,
-                                   "audio_per_rir.csv", "audio, held-out test split");
-  out["grid"] = run.run().config.audio.grid;
+  // Checked before anything is scored or written.
+  std::optional<data::RirSet> novel;
   if (!args.novel_data.empty()) {
-    const data::RirSet novel = load_rirs(args.novel_data, !args.quiet);
-    train::check_same_room_format(run.run().manifest.at("audio"), novel, args.novel_data);
-    std::vector<int64_t> all(novel.rirs.size());
-    for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int64_t>(i);
-    if (args.max_rirs >= 0 && static_cast<int64_t>(all.size()) > args.max_rirs)
-      all.resize(static_cast<size_t>(args.max_rirs));
+    novel = load_rirs(args.novel_data, !args.quiet);
+    train::check_same_room_format(run.run().manifest.at("audio"), *novel, args.novel_data);
+  }
+  auto first_rirs = [&](std::vector<int64_t> rirs_to_score) {  // --max-rirs
+    if (args.max_rirs >= 0 && static_cast<int64_t>(rirs_to_score.size()) > args.max_rirs)
+      rirs_to_score.resize(static_cast<size_t>(args.max_rirs));
+    return rirs_to_score;
+  };
+  nlohmann::json out = score_audio(run, ablations, {rirs, subset, rirs, first_rirs(rirs.test)},
+                                   opts, "audio_per_rir.csv", "audio, held-out test split");
+  out["grid"] = run.run().config.audio.grid;
+  if (novel) {
+    std::vector<int64_t> all(novel->rirs.size());
+    std::iota(all.begin(), all.end(), int64_t{0});
     opts.num_images = 0;
-    out["novel"] =
-        score_audio(run, ablations, {rirs, subset, novel, all}, opts, "audio_novel_per_rir.csv",
-                    "audio at new microphone positions (" + args.novel_data + ")");
+    out["novel"] = score_audio(run, ablations, {rirs, subset, *novel, first_rirs(all)}, opts,
+                               "audio_novel_per_rir.csv",
+                               "audio at new microphone positions (" + args.novel_data + ")");
     out["novel"]["data"] = args.novel_data;
   }
   return out;

@@ -35,6 +35,8 @@ void run_synth(const SynthArgs& a) {
           "synth: give exactly one of --scene FILE.json or --preset NAME (" + preset_list() + ")");
   sim::Scene scene = a.preset.empty() ? sim::load_scene(a.scene_file) : sim::preset_scene(a.preset);
   if (!a.mics.empty()) scene.microphones.kind = a.mics;
+  require(a.mic_count == 0 || scene.microphones.kind == "random",
+          "--mic-count: only used with random microphones; add --mics random");
   if (a.mic_count > 0) scene.microphones.random.count = a.mic_count;
   const std::string where = a.preset.empty() ? a.scene_file : "preset " + a.preset;
   if (!a.preset.empty() || !a.mics.empty() || a.mic_count > 0) sim::validate_scene(scene, where);
