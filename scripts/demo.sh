@@ -20,9 +20,10 @@ step "1/6 synthesize the demo room (pictures + binaural RIRs, SoundSpaces layout
 $NERAF synth --preset demo --layout soundspaces --out "$OUT/scene" --seed 1 --force
 $NERAF info "$OUT/scene"
 # The same room heard at 50 random microphone positions the training never sees (its test split
-# holds out source/heading pairs at trained positions): scored by eval --novel-data.
+# holds out source/heading pairs at trained positions), at the same scale: scored by eval
+# --novel-data.
 $NERAF synth --preset demo --layout soundspaces --mics random --out "$OUT/novel" --seed 2 \
-  --force --quiet
+  --gain-from "$OUT/scene" --force --quiet
 
 step "2/6 train the radiance and acoustic fields jointly (cpu preset)"
 $NERAF train --data "$OUT/scene" --out "$OUT/run" --force

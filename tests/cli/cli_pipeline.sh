@@ -35,7 +35,7 @@ done
 expect_file "$R/eval/audio_per_rir.csv"
 # New microphone positions in the same room, and an ablation run with absolute positions only.
 expect_exit 0 "$NERAF" synth --preset demo --layout soundspaces --mics random --mic-count 2 \
-  --out "$TMP/novel" --seed 4 --quiet
+  --out "$TMP/novel" --seed 4 --gain-from "$S" --quiet
 expect_exit 0 "$NERAF" train --data "$S" --modality audio --vision-run "$R" --steps 2 \
   --no-relative-geometry --out "$TMP/absolute" --quiet
 expect_exit 0 "$NERAF" eval --run "$R" --json "$TMP/novel.json" --skip-vision --max-rirs 3 \
@@ -45,6 +45,13 @@ for key in '"novel"' '"absolute"' '"relative_geometry": false'; do
 done
 expect_in "$TMP/out" "new microphone positions"
 expect_file "$R/eval/audio_novel_per_rir.csv"
+# The same positions at the automatic gain: another scale, refused (it would bias the STFT error).
+expect_exit 0 "$NERAF" synth --preset demo --layout soundspaces --mics random --mic-count 2 \
+  --out "$TMP/novel_scaled" --seed 4 --quiet
+expect_exit 1 "$NERAF" eval --run "$R" --json "$TMP/x.json" --skip-vision \
+  --novel-data "$TMP/novel_scaled"
+expect_in "$TMP/err" "--gain-from"
+expect_exit 2 "$NERAF" synth --preset demo --gain-from "$TMP/no-such-set" --out "$TMP/x" --quiet
 expect_exit 0 "$NERAF" synth --preset demo --layout raf --out "$TMP/raf" --seed 4 --quiet
 expect_exit 1 "$NERAF" eval --run "$R" --json "$TMP/x.json" --skip-vision --novel-data "$TMP/raf"
 expect_in "$TMP/err" "differs from the run's"

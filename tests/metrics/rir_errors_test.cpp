@@ -225,5 +225,22 @@ TEST(Summary, PlainMeanSampleStdAndInvalidFraction) {
   EXPECT_TRUE(std::isnan(summarize({}).t60_error_pct.mean));
 }
 
+TEST(PairedDifference, HandComputedMeanStandardErrorAndWins) {
+  // Differences −1, 0, −2, 1 (the NaN pair is left out): mean −0.5; deviations −0.5, 0.5, −1.5,
+  // 1.5 → sample variance 5/3; standard error √(5/3) / √4. First better where d < 0: 2 of 4.
+  const PairedDifference d =
+      paired_difference({1.0, 2.0, 3.0, std::nan(""), 4.0}, {2.0, 2.0, 5.0, 1.0, 3.0});
+  EXPECT_EQ(d.count, 4u);
+  EXPECT_DOUBLE_EQ(d.mean, -0.5);
+  EXPECT_NEAR(d.standard_error, std::sqrt(5.0 / 3.0) / 2.0, 1e-12);
+  EXPECT_EQ(d.first_better, 2u);
+
+  const PairedDifference one = paired_difference({1.0}, {3.0});
+  EXPECT_DOUBLE_EQ(one.mean, -2.0);
+  EXPECT_TRUE(std::isnan(one.standard_error));
+  EXPECT_TRUE(std::isnan(paired_difference({}, {}).mean));
+  EXPECT_THROW(paired_difference({1.0}, {1.0, 2.0}), Error);
+}
+
 }  // namespace
 }  // namespace neraf::metrics

@@ -267,6 +267,29 @@ TEST(LayoutSynth, SameSeedGivesByteIdenticalFilesAtAnyThreadCount) {
   for (const auto& d : {a, b, c}) fs::remove_all(d);
 }
 
+// A fixed gain (to share another set's scale) replaces the automatic one and scales every sample
+// by exactly gain / automatic gain.
+TEST(LayoutSynth, AGivenGainScalesTheWholeSet) {
+  Scene scene = small_scene();
+  scene.cameras.train_count = 1;
+  scene.cameras.eval_count = 0;
+  const fs::path a = temp_dir("gain_auto"), b = temp_dir("gain_fixed");
+  const SynthSummary automatic = synthesize(scene, options(a, 2, "raf"));
+  SynthOptions fixed = options(b, 2, "raf");
+  fixed.gain = 3 * automatic.gain;
+  const SynthSummary scaled = synthesize(scene, fixed);
+  EXPECT_DOUBLE_EQ(scaled.gain, 3 * automatic.gain);
+  EXPECT_NEAR(scaled.peak, 3 * automatic.peak, 1e-6);
+  EXPECT_DOUBLE_EQ(io::read_json((b / "synth_info.json").string())["gain"].get<double>(),
+                   scaled.gain);
+  const auto x = io::read_audio((a / "data/000003/rir.wav").string());
+  const auto y = io::read_audio((b / "data/000003/rir.wav").string());
+  ASSERT_EQ(x.channels[0].size(), y.channels[0].size());
+  for (size_t i = 0; i < x.channels[0].size(); ++i)
+    ASSERT_NEAR(y.channels[0][i], 3 * x.channels[0][i], 1e-6) << i;
+  for (const auto& d : {a, b}) fs::remove_all(d);
+}
+
 TEST(LayoutSynth, RefusesANonEmptyFolderUnlessForced) {
   Scene scene = small_scene();
   scene.cameras.train_count = 1;

@@ -240,6 +240,42 @@ TEST(AudioEval, RunFolderPredictsAndWritesJsonCsvPng) {
   }
 }
 
+// Paired neraf − baseline differences on hand-made per-RIR errors.
+TEST(AudioEval, PairedDifferencesAgainstEachBaseline) {
+  auto method = [](const std::string& name, std::vector<double> c50) {
+    AudioMethodEval m{name, {}, {}};
+    for (double v : c50) {
+      metrics::RirErrors r;
+      r.c50_error_db = v;
+      r.t60_error_pct = 2.0;  // a tie on T60
+      m.per_rir.push_back(r);
+    }
+    return m;
+  };
+  AudioEval e;
+  e.rir_ids = {"a", "b", "c"};
+  e.methods = {method("neraf", {0.5, 0.5, 1.0}), method("nearest", {1.0, 1.5, 1.5}),
+               method("linear", {0.5, 1.0, 0.5})};
+  const nlohmann::json j = paired_to_json(e);
+  // nearest: differences −0.5, −1, −0.5 → mean −2/3, s.d. √(1/12), s.e. √(1/12)/√3 = 1/6.
+  EXPECT_NEAR(j["nearest"]["c50_error_db"]["mean_difference"].get<double>(), -2.0 / 3.0, 1e-12);
+  EXPECT_NEAR(j["nearest"]["c50_error_db"]["standard_error"].get<double>(), 1.0 / 6.0, 1e-12);
+  EXPECT_EQ(j["nearest"]["c50_error_db"]["neraf_better"], 3);
+  EXPECT_EQ(j["nearest"]["c50_error_db"]["n"], 3);
+  // linear: 0, −0.5, +0.5 → mean 0, one RIR where neraf is better.
+  EXPECT_NEAR(j["linear"]["c50_error_db"]["mean_difference"].get<double>(), 0.0, 1e-12);
+  EXPECT_EQ(j["linear"]["c50_error_db"]["neraf_better"], 1);
+  EXPECT_EQ(j["linear"]["t60_error_pct"]["neraf_better"], 0);
+  EXPECT_TRUE(j["linear"]["edt_error_s"].contains("standard_error"));
+  const std::string table = paired_table(e);
+  EXPECT_NE(table.find("linear"), std::string::npos);
+  EXPECT_NE(table.find("C50 -0.667"), std::string::npos) << table;
+  // Without baselines (e.g. eval --no-baselines) there is nothing to pair.
+  e.methods.resize(1);
+  EXPECT_TRUE(paired_to_json(e).empty());
+  EXPECT_EQ(paired_table(e), "");
+}
+
 TEST(AudioRun, VisionRunHasNoAcousticField) {
   const std::string dir = make_temp_dir("visiononly");
   TrainConfig c = fixtures::tiny_train_config();

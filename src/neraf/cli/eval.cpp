@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -72,6 +73,8 @@ nlohmann::json score_audio(const train::AudioRun& run,
   train::AudioEval e =
       train::evaluate_audio(run, set.train_set, set.train_subset, set.test_set, set.test, opts);
   nlohmann::json out = train::to_json(e);
+  const nlohmann::json paired = train::paired_to_json(e);
+  if (!paired.empty()) out["paired"] = paired;
   if (!ablations.empty()) {
     nlohmann::json abl = nlohmann::json::object();
     train::AudioEvalOptions o = opts;
@@ -92,9 +95,9 @@ nlohmann::json score_audio(const train::AudioRun& run,
   std::filesystem::create_directories(opts.out_dir);
   train::write_audio_csv(csv, e);
   out["per_rir_csv"] = csv;
-  std::printf("%s (%s, %zu RIRs, %.1f s; per-RIR CSV %s):\n%s", title.c_str(),
+  std::printf("%s (%s, %zu RIRs, %.1f s; per-RIR CSV %s):\n%s%s", title.c_str(),
               data::to_string(set.test_set.layout), e.rir_ids.size(), e.seconds, csv.c_str(),
-              train::audio_table(e.methods).c_str());
+              train::audio_table(e.methods).c_str(), train::paired_table(e).c_str());
   return out;
 }
 
@@ -102,6 +105,22 @@ data::RirSet load_rirs(const std::string& dir, bool progress) {
   data::RirLoadOptions load;
   load.progress = progress;
   return data::load_rir_set(dir, load);
+}
+
+// Simulated sets record the scale their RIRs were written at (synth_info.json). A set at another
+// scale would bias the STFT error (the other metrics are scale-free), so it is refused.
+void check_same_gain(const std::string& run_data_dir, const std::string& novel_dir) {
+  const auto gain = [](const std::string& dir) -> std::optional<double> {
+    const std::string path = dir + "/synth_info.json";
+    if (!std::filesystem::exists(path)) return std::nullopt;
+    return io::read_json(path).value("gain", 0.0);
+  };
+  const std::optional<double> expected = gain(run_data_dir), got = gain(novel_dir);
+  if (!expected || !got) return;
+  require(std::abs(*expected - *got) <= 1e-9 * std::max(*expected, *got),
+          novel_dir + ": its RIRs were synthesised at gain " + std::to_string(*got) +
+              ", the run's data at " + std::to_string(*expected) +
+              "; re-synthesise it with `neraf synth ... --gain-from " + run_data_dir + "`");
 }
 
 // The acoustic field on the test RIRs (and, with --novel-data, on every RIR of another dataset of
@@ -133,6 +152,7 @@ nlohmann::json evaluate_audio_json(const train::AudioRun& run, const EvalArgs& a
   if (!args.novel_data.empty()) {
     novel = load_rirs(args.novel_data, !args.quiet);
     train::check_same_room_format(run.run().manifest.at("audio"), *novel, args.novel_data);
+    check_same_gain(data_dir, args.novel_data);
   }
   auto first_rirs = [&](std::vector<int64_t> rirs_to_score) {  // --max-rirs
     if (args.max_rirs >= 0 && static_cast<int64_t>(rirs_to_score.size()) > args.max_rirs)

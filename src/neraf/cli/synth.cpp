@@ -2,10 +2,12 @@
 #include <omp.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 
 #include "neraf/cli/commands.h"
+#include "neraf/io/json_file.h"
 #include "neraf/sim/presets.h"
 #include "neraf/sim/scene_json.h"
 #include "neraf/sim/synthesize.h"
@@ -17,7 +19,7 @@ namespace neraf::cli {
 namespace {
 
 struct SynthArgs {
-  std::string scene_file, preset, layout = "soundspaces", out_dir, hrtf, mics;
+  std::string scene_file, preset, layout = "soundspaces", out_dir, hrtf, mics, gain_from;
   int64_t mic_count = 0;
   uint64_t seed = 0;
   int threads = 0;
@@ -28,6 +30,17 @@ std::string preset_list() {
   std::string s;
   for (const auto& n : sim::preset_names()) s += (s.empty() ? "" : ", ") + n;
   return s;
+}
+
+// The gain a previous `neraf synth` scaled its RIRs by (its synth_info.json).
+double recorded_gain(const std::string& dataset_dir) {
+  const std::string path = dataset_dir + "/synth_info.json";
+  require(std::filesystem::exists(path),
+          "--gain-from: " + path + " not found; give a folder written by neraf synth");
+  const nlohmann::json info = io::read_json(path);
+  const double gain = info.value("gain", 0.0);
+  require(gain > 0, path + ": no positive \"gain\"; re-synthesise that folder");
+  return gain;
 }
 
 void run_synth(const SynthArgs& a) {
@@ -66,6 +79,7 @@ void run_synth(const SynthArgs& a) {
   opt.force = a.force;
   opt.progress = !a.quiet;
   opt.hrtf_path = a.hrtf;
+  if (!a.gain_from.empty()) opt.gain = recorded_gain(a.gain_from);
   const sim::SynthSummary s = sim::synthesize(scene, opt);
 
   std::printf("synthesised scene \"%s\" in the %s layout into %s\n", scene.name.c_str(),
@@ -115,6 +129,10 @@ void register_synth(CLI::App& app) {
   cmd->add_option("--mic-count", args->mic_count,
                   "Number of random microphone positions (with --mics random)")
       ->check(CLI::Range(1, 1000000));
+  cmd->add_option("--gain-from", args->gain_from,
+                  "Scale the RIRs by the gain of this earlier synth folder instead of putting "
+                  "the peak at 0.5, so both sets share one scale (needed by eval --novel-data)")
+      ->check(CLI::ExistingDirectory);
   cmd->add_option("--out", args->out_dir, "Output folder (created; must be empty unless --force)");
   cmd->add_option("--seed", args->seed,
                   "Seed of every random choice (camera and random-microphone placement, splits, "

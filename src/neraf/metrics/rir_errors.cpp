@@ -124,6 +124,24 @@ MetricStats mean_and_std(const std::vector<double>& values) {
   return s;
 }
 
+PairedDifference paired_difference(const std::vector<double>& first,
+                                   const std::vector<double>& second) {
+  require(first.size() == second.size(), "paired_difference: " + std::to_string(first.size()) +
+                                             " vs " + std::to_string(second.size()) + " values");
+  std::vector<double> d;
+  PairedDifference p;
+  for (size_t i = 0; i < first.size(); ++i) {
+    if (!std::isfinite(first[i]) || !std::isfinite(second[i])) continue;
+    d.push_back(first[i] - second[i]);
+    if (first[i] < second[i]) ++p.first_better;
+  }
+  const MetricStats s = mean_and_std(d);
+  p.count = d.size();
+  p.mean = s.mean;
+  p.standard_error = s.std / std::sqrt(double(p.count));
+  return p;
+}
+
 RirErrorSummary summarize(const std::vector<RirErrors>& errors) {
   RirErrorSummary s;
   s.count = errors.size();

@@ -80,4 +80,18 @@ struct RirErrorSummary {
 
 RirErrorSummary summarize(const std::vector<RirErrors>& errors);
 
+// Two methods scored on the same RIRs: the per-RIR differences `first[i] − second[i]` of one
+// metric's errors. A difference of two means over a few dozen RIRs is noisy; its standard error
+// (sample s.d. of the differences / √n) says whether it stands out of that noise. Pairs with a
+// non-finite value are left out (`count` says how many were kept); sizes must match.
+struct PairedDifference {
+  double mean = 0.0;            // mean of first − second (NaN without pairs)
+  double standard_error = 0.0;  // NaN for fewer than two pairs
+  size_t first_better = 0;      // pairs where first < second (lower error)
+  size_t count = 0;
+};
+
+PairedDifference paired_difference(const std::vector<double>& first,
+                                   const std::vector<double>& second);
+
 }  // namespace neraf::metrics

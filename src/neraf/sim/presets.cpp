@@ -59,7 +59,10 @@ Scene demo() {
   s.furniture = {box({2.2, 0.375, 1.6}, {1.2, 0.75, 0.7}, 15, "wood"),
                  box({0.55, 0.4, 2.4}, {0.8, 0.8, 1.6}, 0, "fabric"),
                  box({3.55, 0.9, 0.5}, {0.6, 1.8, 0.9}, 0, "shelf")};
-  s.sources = {source({1.1, 1.2, 0.9}, 0, "omni"), source({3.0, 1.0, 2.9}, 45, "cardioid")};
+  // Four sources, so that the held-out 10 % (≈ 46 RIRs) can tell apart methods whose mean errors
+  // differ by a tenth of a dB: with two, the split had 23 RIRs and a standard error of ≈ 0.1 dB.
+  s.sources = {source({1.1, 1.2, 0.9}, 0, "omni"), source({3.0, 1.0, 2.9}, 45, "cardioid"),
+               source({2.45, 0.9, 0.75}, 180, "cardioid"), source({1.75, 1.3, 2.95}, 0, "omni")};
   s.microphones.kind = "grid";
   s.microphones.grid.spacing_m = 0.55;
   s.microphones.grid.height_m = 1.5;

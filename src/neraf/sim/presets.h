@@ -1,7 +1,7 @@
 #pragma once
 // Built-in scenes (`neraf synth --preset NAME`). Each is an ordinary Scene value: what
 // `scene_to_json(preset_scene(name))` prints can be edited and passed back with --scene.
-//   demo       4 × 2.7 × 3.5 m, 3 textured boxes, 29 grid points × 4 headings × 2 sources = 232
+//   demo       4 × 2.7 × 3.5 m, 3 textured boxes, 29 grid points × 4 headings × 4 sources = 464
 //              binaural RIRs (0.6 s), 50 + 10 photos at 96 × 96 — trains in minutes on 2 cores.
 //   shoebox    5 × 3 × 4 m empty room, one uniform material (for Sabine/Eyring checks), 20 × 4 × 1
 //              = 80 RIRs (1 s), 30 + 10 photos at 96 × 96.

@@ -163,7 +163,9 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
 
   // The gain: the loudest RIRs are those of the closest source-microphone pairs (the direct path
   // dominates the peak), so their peak - over every heading - bounds the whole set.
-  {
+  if (options.gain > 0) {
+    sum.gain = options.gain;
+  } else {
     std::vector<size_t> order(plan.jobs.size());
     std::iota(order.begin(), order.end(), size_t{0});
     const auto dist = [&](size_t i) {

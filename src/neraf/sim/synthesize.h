@@ -26,6 +26,9 @@ struct SynthOptions {
   bool force = false;     // write into a non-empty out_dir (files are replaced atomically)
   bool progress = true;   // progress bars on stderr
   std::string hrtf_path;  // SOFA file for binaural RIRs; empty: Hrtf::kDefaultSofa
+  // > 0: every RIR is scaled by this instead of the automatic gain (which puts the set's peak at
+  // 0.5), so that a second set of the same room shares the first one's scale.
+  double gain = 0;
 };
 
 // One RIR file of the plan.

@@ -207,6 +207,80 @@ nlohmann::json to_json(const AudioEval& e) {
   return j;
 }
 
+namespace {
+
+struct PairedMetric {
+  const char* key;  // JSON key
+  const char* label;
+  const char* unit;
+  double metrics::RirErrors::*member;
+  int digits;
+};
+constexpr PairedMetric kPairedMetrics[] = {
+    {"t60_error_pct", "T60", "%", &metrics::RirErrors::t60_error_pct, 3},
+    {"c50_error_db", "C50", "dB", &metrics::RirErrors::c50_error_db, 3},
+    {"edt_error_s", "EDT", "s", &metrics::RirErrors::edt_error_s, 5}};
+
+// Calls fn(baseline, metric, neraf − baseline) for each baseline present in `e`.
+template <class Fn>
+void for_each_paired(const AudioEval& e, Fn fn) {
+  const auto find = [&](const std::string& name) -> const AudioMethodEval* {
+    for (const auto& m : e.methods)
+      if (m.name == name) return &m;
+    return nullptr;
+  };
+  const auto values = [](const AudioMethodEval& m, double metrics::RirErrors::*member) {
+    std::vector<double> v;
+    for (const auto& r : m.per_rir) v.push_back(r.*member);
+    return v;
+  };
+  const AudioMethodEval* neraf = find("neraf");
+  if (!neraf) return;
+  for (const char* name : {"nearest", "linear"}) {
+    const AudioMethodEval* baseline = find(name);
+    if (!baseline) continue;
+    for (const PairedMetric& m : kPairedMetrics)
+      fn(name, m,
+         metrics::paired_difference(values(*neraf, m.member), values(*baseline, m.member)));
+  }
+}
+
+}  // namespace
+
+nlohmann::json paired_to_json(const AudioEval& e) {
+  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+  nlohmann::json j = nlohmann::json::object();
+  for_each_paired(
+      e, [&](const char* baseline, const PairedMetric& m, const metrics::PairedDifference& d) {
+        j[baseline][m.key] = {{"mean_difference", num(d.mean)},
+                              {"standard_error", num(d.standard_error)},
+                              {"neraf_better", d.first_better},
+                              {"n", d.count}};
+      });
+  return j;
+}
+
+std::string paired_table(const AudioEval& e) {
+  std::ostringstream out;
+  std::string current;
+  char buf[160];
+  for_each_paired(
+      e, [&](const char* baseline, const PairedMetric& m, const metrics::PairedDifference& d) {
+        if (current != baseline) {
+          if (current.empty())
+            out << "neraf − baseline per RIR (mean ± standard error; RIRs where neraf is better):";
+          current = baseline;
+          std::snprintf(buf, sizeof buf, "\n  %-8s", baseline);
+          out << buf;
+        }
+        std::snprintf(buf, sizeof buf, "  %s %+.*f ± %.*f %s (%zu/%zu)", m.label, m.digits, d.mean,
+                      m.digits, d.standard_error, m.unit, d.first_better, d.count);
+        out << buf;
+      });
+  if (!current.empty()) out << "\n";
+  return out.str();
+}
+
 void write_audio_csv(const std::string& path, const AudioEval& e) {
   std::ostringstream out;
   out << "rir_id,method,t60_error_pct,c50_error_db,edt_error_s,stft_error,invalid_t60,"

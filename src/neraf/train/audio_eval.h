@@ -77,6 +77,12 @@ AudioMethodEval evaluate_audio_model(const AudioRun& run, const data::RirSet& ri
 nlohmann::json to_json(const metrics::RirErrorSummary& s);
 // {"neraf": {...}, "nearest": {...}, "linear": {...}}
 nlohmann::json to_json(const AudioEval& e);
+// neraf against each baseline on the same RIRs (metrics::paired_difference of the T60, C50 and
+// EDT errors, neraf − baseline): {"nearest": {"t60_error_pct": {"mean_difference",
+// "standard_error", "neraf_better", "n"}, ...}, "linear": {...}}; empty without baselines.
+nlohmann::json paired_to_json(const AudioEval& e);
+// The same as lines to print under the table ("" without baselines).
+std::string paired_table(const AudioEval& e);
 // Writes "rir_id,method,t60_error_pct,c50_error_db,edt_error_s,stft_error,invalid_t60,
 // t60_pred_s,t60_gt_s,c50_pred_db,c50_gt_db" rows (the last four: channel means of the measured
 // values, to show a bias).
