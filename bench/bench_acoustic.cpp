@@ -105,14 +105,14 @@ void BM_NacfFwdBwd(benchmark::State& state) {
   const auto feature = torch::rand({o.nacf.grid_features});
   if (bf16) {
     torch::NoGradGuard g;
-    const auto h = nacf_input(feature, b.t, kMaxLen, b.mic, b.src, b.rot);
+    const auto h = nacf_input(o.nacf, feature, b.t, kMaxLen, b.mic, b.src, b.rot);
     const auto d = (net->forward(h) - ref->forward(h)).abs();
     state.counters["mean_abs_err"] = d.mean().item<double>();
     state.counters["max_abs_err"] = d.max().item<double>();
   }
   for (auto _ : state) {
     net->zero_grad();
-    const auto h = nacf_input(feature, b.t, kMaxLen, b.mic, b.src, b.rot);
+    const auto h = nacf_input(o.nacf, feature, b.t, kMaxLen, b.mic, b.src, b.rot);
     auto loss = sc_slmse_loss(net->forward(h), b.gt);
     loss.total.backward();
     benchmark::DoNotOptimize(loss.total.item<float>());

@@ -83,12 +83,8 @@ torch::Tensor AcousticModelImpl::forward_with_feature(const torch::Tensor& featu
                                                       const torch::Tensor& mic_norm,
                                                       const torch::Tensor& src_norm,
                                                       const torch::Tensor& rot) {
-  const NacfOptions& o = options_.nacf;
-  auto h = nacf_input(feature, t, options_.max_len, mic_norm, src_norm, rot,
-                      o.position_max_freq_exp);  // [B, G + 163]
-  if (o.relative_geometry)
-    h = torch::cat({h, encode_relative_geometry(mic_norm, src_norm, rot, o.extent_m)}, 1);
-  return field_->forward(h);  // [B, C, F]
+  return field_->forward(nacf_input(options_.nacf, feature, t, options_.max_len, mic_norm, src_norm,
+                                    rot));  // [B, C, F]
 }
 
 torch::Tensor AcousticModelImpl::forward(const torch::Tensor& grid, const torch::Tensor& t,

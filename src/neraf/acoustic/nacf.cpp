@@ -119,6 +119,15 @@ torch::Tensor nacf_input(const torch::Tensor& grid_feature, const torch::Tensor&
   return torch::cat({g, time, mic, src, r}, 1);  // [B, G + 163]
 }
 
+torch::Tensor nacf_input(const NacfOptions& options, const torch::Tensor& grid_feature,
+                         const torch::Tensor& t, int64_t max_len, const torch::Tensor& mic_norm,
+                         const torch::Tensor& src_norm, const torch::Tensor& rot) {
+  const torch::Tensor h = nacf_input(grid_feature, t, max_len, mic_norm, src_norm, rot,
+                                     options.position_max_freq_exp);  // [B, G + 163]
+  if (!options.relative_geometry) return h;
+  return torch::cat({h, encode_relative_geometry(mic_norm, src_norm, rot, options.extent_m)}, 1);
+}
+
 NacfImpl::NacfImpl(NacfOptions options) : options_(std::move(options)) {
   require(options_.grid_features >= 0, "nacf grid_features: must be >= 0");
   require(!options_.trunk.empty(), "nacf trunk: needs at least one layer");

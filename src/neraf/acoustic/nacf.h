@@ -97,6 +97,12 @@ torch::Tensor nacf_input(const torch::Tensor& grid_feature, const torch::Tensor&
                          const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
                          const torch::Tensor& rot, double position_max_freq_exp = 8.0);
 
+// Every input a Nacf built with `options` expects: nacf_input with its position frequencies, then
+// (options.relative_geometry) encode_relative_geometry → [B, options.in_features()].
+torch::Tensor nacf_input(const NacfOptions& options, const torch::Tensor& grid_feature,
+                         const torch::Tensor& t, int64_t max_len, const torch::Tensor& mic_norm,
+                         const torch::Tensor& src_norm, const torch::Tensor& rot);
+
 class NacfImpl : public torch::nn::Module {
  public:
   explicit NacfImpl(NacfOptions options = {});
