@@ -16,6 +16,7 @@
 #include "neraf/cli/commands.h"
 #include "neraf/data/image_set.h"
 #include "neraf/io/json_file.h"
+#include "neraf/sim/synthesize.h"
 #include "neraf/train/audio_branch.h"
 #include "neraf/train/audio_eval.h"
 #include "neraf/train/audio_run.h"
@@ -110,12 +111,8 @@ data::RirSet load_rirs(const std::string& dir, bool progress) {
 // Simulated sets record the scale their RIRs were written at (synth_info.json). A set at another
 // scale would bias the STFT error (the other metrics are scale-free), so it is refused.
 void check_same_gain(const std::string& run_data_dir, const std::string& novel_dir) {
-  const auto gain = [](const std::string& dir) -> std::optional<double> {
-    const std::string path = dir + "/synth_info.json";
-    if (!std::filesystem::exists(path)) return std::nullopt;
-    return io::read_json(path).value("gain", 0.0);
-  };
-  const std::optional<double> expected = gain(run_data_dir), got = gain(novel_dir);
+  const std::optional<double> expected = sim::synthesized_gain(run_data_dir),
+                              got = sim::synthesized_gain(novel_dir);
   if (!expected || !got) return;
   require(std::abs(*expected - *got) <= 1e-9 * std::max(*expected, *got),
           novel_dir + ": its RIRs were synthesised at gain " + std::to_string(*got) +

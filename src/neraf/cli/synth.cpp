@@ -2,12 +2,11 @@
 #include <omp.h>
 
 #include <cstdio>
-#include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "neraf/cli/commands.h"
-#include "neraf/io/json_file.h"
 #include "neraf/sim/presets.h"
 #include "neraf/sim/scene_json.h"
 #include "neraf/sim/synthesize.h"
@@ -30,17 +29,6 @@ std::string preset_list() {
   std::string s;
   for (const auto& n : sim::preset_names()) s += (s.empty() ? "" : ", ") + n;
   return s;
-}
-
-// The gain a previous `neraf synth` scaled its RIRs by (its synth_info.json).
-double recorded_gain(const std::string& dataset_dir) {
-  const std::string path = dataset_dir + "/synth_info.json";
-  require(std::filesystem::exists(path),
-          "--gain-from: " + path + " not found; give a folder written by neraf synth");
-  const nlohmann::json info = io::read_json(path);
-  const double gain = info.value("gain", 0.0);
-  require(gain > 0, path + ": no positive \"gain\"; re-synthesise that folder");
-  return gain;
 }
 
 void run_synth(const SynthArgs& a) {
@@ -79,7 +67,12 @@ void run_synth(const SynthArgs& a) {
   opt.force = a.force;
   opt.progress = !a.quiet;
   opt.hrtf_path = a.hrtf;
-  if (!a.gain_from.empty()) opt.gain = recorded_gain(a.gain_from);
+  if (!a.gain_from.empty()) {
+    const std::optional<double> gain = sim::synthesized_gain(a.gain_from);
+    require(gain.has_value(), "--gain-from " + a.gain_from +
+                                  ": no synth_info.json; give a folder written by neraf synth");
+    opt.gain = *gain;
+  }
   const sim::SynthSummary s = sim::synthesize(scene, opt);
 
   std::printf("synthesised scene \"%s\" in the %s layout into %s\n", scene.name.c_str(),

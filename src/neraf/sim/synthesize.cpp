@@ -271,4 +271,12 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
   return sum;
 }
 
+std::optional<double> synthesized_gain(const std::string& dataset_dir) {
+  const std::string path = (fs::path(dataset_dir) / "synth_info.json").string();
+  if (!fs::exists(path)) return std::nullopt;
+  const double gain = io::read_json(path).value("gain", 0.0);
+  require(gain > 0, path + ": no positive \"gain\"; synthesise that folder again");
+  return gain;
+}
+
 }  // namespace neraf::sim

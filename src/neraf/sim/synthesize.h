@@ -11,6 +11,7 @@
 //
 // Deterministic: the same scene + seed give byte-identical files for any thread count.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -70,5 +71,9 @@ struct SynthSummary {
 // in NeRAF's loaders (which clip to [-1, 1]) and relative levels stay physical; the gain is
 // recorded in synth_info.json.
 SynthSummary synthesize(const Scene& scene, const SynthOptions& options);
+
+// The gain a `neraf synth` folder's RIRs were scaled by (its synth_info.json); none for a folder
+// without that file (e.g. a real dataset). neraf::Error when the file has no positive gain.
+std::optional<double> synthesized_gain(const std::string& dataset_dir);
 
 }  // namespace neraf::sim
