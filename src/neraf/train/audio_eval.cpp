@@ -19,6 +19,11 @@ namespace neraf::train {
 
 namespace {
 
+// A metric value for JSON: null when not finite (JSON has no NaN).
+nlohmann::json json_number(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
 double dist3(const geometry::Vec3& a, const geometry::Vec3& b) {
   const double dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z;
   return std::sqrt(dx * dx + dy * dy + dz * dz);
@@ -184,7 +189,6 @@ AudioEval evaluate_audio(const AudioRun& run, const data::RirSet& train_set,
 }
 
 nlohmann::json to_json(const metrics::RirErrorSummary& s) {
-  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
   nlohmann::json j;
   j["n_rirs"] = s.count;
   const std::pair<const char*, const metrics::MetricStats*> keys[] = {
@@ -194,8 +198,8 @@ nlohmann::json to_json(const metrics::RirErrorSummary& s) {
       {"stft_error", &s.stft_error},
       {"invalid_t60", &s.invalid_t60}};
   for (const auto& [k, m] : keys) {
-    j[k] = num(m->mean);
-    j[std::string(k) + "_std"] = num(m->std);
+    j[k] = json_number(m->mean);
+    j[std::string(k) + "_std"] = json_number(m->std);
     if (m->non_finite > 0) j[std::string(k) + "_non_finite"] = m->non_finite;
   }
   return j;
@@ -248,12 +252,11 @@ void for_each_paired(const AudioEval& e, Fn fn) {
 }  // namespace
 
 nlohmann::json paired_to_json(const AudioEval& e) {
-  auto num = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
   nlohmann::json j = nlohmann::json::object();
   for_each_paired(
       e, [&](const char* baseline, const PairedMetric& m, const metrics::PairedDifference& d) {
-        j[baseline][m.key] = {{"mean_difference", num(d.mean)},
-                              {"standard_error", num(d.standard_error)},
+        j[baseline][m.key] = {{"mean_difference", json_number(d.mean)},
+                              {"standard_error", json_number(d.standard_error)},
                               {"neraf_better", d.first_better},
                               {"n", d.count}};
       });
