@@ -16,7 +16,7 @@ SRC=1.1,1.2,0.9
 
 step() { printf '\n== %s\n' "$*"; }
 
-step "1/6 synthesize the demo room (pictures + binaural RIRs, SoundSpaces layout)"
+step "1/7 synthesize the demo room (pictures + binaural RIRs, SoundSpaces layout)"
 $NERAF synth --preset demo --layout soundspaces --out "$OUT/scene" --seed 1 --force
 $NERAF info "$OUT/scene"
 # The same room heard at 50 random microphone positions the training never sees (its test split
@@ -25,7 +25,7 @@ $NERAF info "$OUT/scene"
 $NERAF synth --preset demo --layout soundspaces --mics random --out "$OUT/novel" --seed 2 \
   --gain-from "$OUT/scene" --force --quiet
 
-step "2/6 train the radiance and acoustic fields jointly (cpu preset)"
+step "2/7 train the radiance and acoustic fields jointly (cpu preset)"
 $NERAF train --data "$OUT/scene" --out "$OUT/run" --force
 # Ablations, each the acoustic field alone on the joint run's frozen field (2000 steps, as many
 # audio steps as the joint run): the paper's no-grid and all-zero-grid, and without the
@@ -37,21 +37,29 @@ done
 $NERAF train --data "$OUT/scene" --modality audio --vision-run "$OUT/run" --no-relative-geometry \
   --steps 2000 --out "$OUT/ablation_absolute_positions" --force
 
-step "3/6 evaluate on the held-out RIRs, new microphone positions and views (baselines and ablations alongside)"
+step "3/7 evaluate on the held-out RIRs, new microphone positions and views (baselines and ablations alongside)"
 $NERAF eval --run "$OUT/run" --json "$OUT/eval.json" --novel-data "$OUT/novel" \
   --ablation-runs "$OUT/ablation_grid_none,$OUT/ablation_grid_zeros,$OUT/ablation_absolute_positions"
 
-step "4/6 render a RIR at a new pose and auralize speech with it"
+step "4/7 render a RIR at a new pose and auralize speech with it"
 $NERAF render rir --run "$OUT/run" --mic "$MIC" --src "$SRC" --yaw 90 --out "$OUT/rir.wav"
 $NERAF metrics --rir "$OUT/rir.wav"
 espeak-ng -w "$OUT/dry_speech.wav" "This is how the demo room sounds, rendered by neraf."
 $NERAF auralize --run "$OUT/run" --mic "$MIC" --src "$SRC" --yaw 90 \
   --in "$OUT/dry_speech.wav" --out "$OUT/speech_in_room.wav" --normalize
 
-step "5/6 render a held-out view"
+step "5/7 render a held-out view"
 $NERAF render view --run "$OUT/run" --frame 0 --out "$OUT/view.png" --depth "$OUT/depth.png"
 
-step "6/6 draw the loudness map of the source"
+step "6/7 draw the loudness map of the source"
 $NERAF render loudness --run "$OUT/run" --src "$SRC" --yaw 90 --out "$OUT/loudness.png"
 
-printf '\nDemo outputs in %s/: eval.json, rir.wav, speech_in_room.wav, view.png, loudness.png\n' "$OUT"
+step "7/7 export the acoustic field for the runtime (neraf_rt) and walk a listener through the room"
+$NERAF export --run "$OUT/run" --out "$OUT/demo.nrf"
+$NERAF render trajectory --model "$OUT/demo.nrf" --path examples/paths/demo_walk.json \
+  --in "$OUT/dry_speech.wav" --out "$OUT/speech_walk.wav" --normalize
+rm -rf "$OUT/rirs"
+$NERAF render rir --model "$OUT/demo.nrf" --poses examples/paths/demo_poses.json --out "$OUT/rirs"
+
+printf '\nDemo outputs in %s/: eval.json, rir.wav, speech_in_room.wav, view.png, loudness.png,\n' "$OUT"
+printf 'demo.nrf (the exported acoustic field), speech_walk.wav (a walk through the room), rirs/\n'

@@ -98,6 +98,14 @@ NERAF_RT_API const char* neraf_status_string(neraf_status status);
 
 /* Model. */
 NERAF_RT_API neraf_status neraf_model_load(const char* path, neraf_model** out);
+/* Load flags. A model exported in bfloat16 (`neraf export --precision bf16`) runs its trunk on
+ * AMX-BF16 tiles where the CPU has them (Intel Sapphire Rapids and later: several times faster;
+ * activations rounded to bfloat16 as in training, ~1e-2 from the float32 result in
+ * log-magnitude), elsewhere in float32 with its bfloat16-rounded weights. */
+#define NERAF_LOAD_FLOAT32 1u /* compute in float32 even where AMX-BF16 is available */
+NERAF_RT_API neraf_status neraf_model_load_ex(const char* path, unsigned flags, neraf_model** out);
+/* What the model's trunk computes in: "float32" or "bfloat16-amx" (static storage). */
+NERAF_RT_API const char* neraf_model_compute(const neraf_model* model);
 NERAF_RT_API void neraf_model_free(neraf_model* model); /* NULL is a no-op */
 NERAF_RT_API neraf_status neraf_model_get_info(const neraf_model* model, neraf_model_info* out);
 
@@ -108,6 +116,15 @@ NERAF_RT_API void neraf_workspace_free(neraf_workspace* workspace);
  * (default 0), as `neraf render rir`. */
 NERAF_RT_API neraf_status neraf_workspace_set_griffin_lim(neraf_workspace* workspace,
                                                           int iterations, uint64_t seed);
+/* Threads a query of this workspace uses: the calling thread plus threads - 1 helpers started
+ * here, which take whole channels (head, calibration, Griffin-Lim) and half the columns of large
+ * layers. 0 = automatic (one per channel, at most the hardware's; the default), 1 = the calling
+ * thread only (e.g. when many workspaces already query in parallel). Results agree to float
+ * rounding (bit for bit on AMX and in Griffin-Lim). A multi-threaded BLAS keeps its own threads
+ * and then does the float32 products unsplit; for steady latency run OpenBLAS on one thread
+ * (OMP_NUM_THREADS=1 or OPENBLAS_NUM_THREADS=1): its idle workers spin on the cores the helpers
+ * need. */
+NERAF_RT_API neraf_status neraf_workspace_set_threads(neraf_workspace* workspace, int threads);
 
 /* Queries. `capacity` is the number of floats `out` holds. */
 /* Predicted log(|STFT| + 1e-3), energy calibration applied: [C, F, T], capacity >= C*F*T. */
@@ -122,24 +139,43 @@ NERAF_RT_API neraf_status neraf_query_rir(const neraf_model* model, neraf_worksp
 /* Streaming auralization: mono dry input, C output channels, uniformly partitioned overlap-save
  * convolution with `block_size` samples per call, a crossfade of one block when the RIR changes.
  * model may be NULL (then only neraf_stream_set_rir is available; channels and max_rir_length
- * must be given); with a model, 0 for channels / max_rir_length means the model's. */
+ * must be given); with a model, 0 for channels / max_rir_length means the model's (channels, if
+ * given, must equal the model's; a max_rir_length below the model's rir_length truncates its
+ * RIRs). Limits: block_size 16 to 16384 (any integer; the FFT size is 2 * block_size),
+ * channels 1 to 16, max_rir_length 1 to 11520000 samples (60 s at 192 kHz). Allocates everything
+ * here (four RIR slots of about 8 bytes per RIR sample and channel each: 3 MB for 1 s binaural
+ * at 48 kHz; the FFT plans, measured once per block size: milliseconds to a second)
+ * and starts the stream's worker thread; with a model, its workspace runs single-threaded
+ * (neraf_workspace_set_threads 1), so the worker never takes more than one core from the audio
+ * thread. */
 NERAF_RT_API neraf_status neraf_stream_create(const neraf_model* model, int channels,
                                               int block_size, size_t max_rir_length,
                                               neraf_stream** out);
+/* Joins the worker (after the query in progress, if any; a pending one is dropped). NULL is a
+ * no-op. */
 NERAF_RT_API void neraf_stream_free(neraf_stream* stream);
-/* A new pose: validated here, its RIR computed on the stream's worker thread and handed to the
- * audio thread without locks when ready (a newer pose replaces a pending one). */
+/* A new pose: validated here (NERAF_ERR_NOT_FINITE, NERAF_ERR_OUTSIDE as neraf_query_rir), its
+ * RIR computed on the stream's worker thread and handed to the audio thread without locks when
+ * ready. Latest wins: a newer set_pose or set_rir replaces a request the worker has not started.
+ * NERAF_ERR_INVALID_ARGUMENT on a stream without a model. */
 NERAF_RT_API neraf_status neraf_stream_set_pose(neraf_stream* stream, const neraf_pose* pose,
                                                 unsigned flags);
-/* A given RIR (planar [channels, length], length <= max_rir_length), handed over as a pose's. */
+/* A given RIR (planar [channels, length], channels the stream's, 1 <= length <= max_rir_length,
+ * finite values), handed over as a pose's: copied here (rir may be reused on return), prepared
+ * on the worker thread. */
 NERAF_RT_API neraf_status neraf_stream_set_rir(neraf_stream* stream, const float* rir,
                                                int channels, size_t length);
 /* Blocks until the RIR of the latest set_pose / set_rir is computed and published, so that the
- * next neraf_stream_process call starts the crossfade to it; NERAF_ERR_INTERNAL after timeout_ms.
+ * next neraf_stream_process call starts the crossfade to it; NERAF_ERR_INTERNAL after timeout_ms
+ * (>= 0; 0 polls). If that request's query failed on the worker, returns its status and message
+ * (the previous RIR then stays in use). NERAF_OK at once when nothing was requested.
  * For offline rendering, where the output must not depend on timing. */
 NERAF_RT_API neraf_status neraf_stream_wait(neraf_stream* stream, int timeout_ms);
-/* Real-time safe. in: block_size mono samples; out: planar [channels, block_size]. Before any
- * RIR is set the output is silence. */
+/* Real-time safe (no allocation, no locks, no system calls; one thread at a time). in:
+ * block_size mono samples; out: planar [channels, block_size]; out may overlap in. Before any RIR
+ * is set the output is silence; a RIR published before the first call applies from the first
+ * sample, one published later fades in over one block (from silence, or from the previous RIR).
+ * Denormals are flushed to zero during the call (the caller's floating-point mode is restored). */
 NERAF_RT_API neraf_status neraf_stream_process(neraf_stream* stream, const float* in, float* out);
 
 #ifdef __cplusplus

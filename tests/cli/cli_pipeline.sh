@@ -67,7 +67,9 @@ expect_in "$TMP/out" '"channels"'
 expect_exit 2 "$NERAF" render rir --run "$R" --mic "$MIC" --src "$SRC" --yaw north --out "$TMP/x.wav"
 expect_exit 2 "$NERAF" render rir --run "$R" --mic 2.0,1.5 --src "$SRC" --out "$TMP/x.wav"
 expect_in "$TMP/err" "--mic"
-expect_exit 0 "$NERAF" render rir --run "$R" --mic 40,1.5,2.5 --src "$SRC" --out "$TMP/far.wav"
+expect_exit 1 "$NERAF" render rir --run "$R" --mic 40,1.5,2.5 --src "$SRC" --out "$TMP/far.wav"
+expect_in "$TMP/err" "--allow-outside"
+expect_exit 0 "$NERAF" render rir --run "$R" --mic 40,1.5,2.5 --src "$SRC" --out "$TMP/far.wav" --allow-outside
 expect_in "$TMP/err" "outside"
 expect_exit 0 "$NERAF" render view --run "$R" --frame 0 --out "$TMP/view.png" --depth "$TMP/depth.png"
 expect_file "$TMP/view.png"
@@ -81,6 +83,67 @@ expect_file "$TMP/map.csv"
 expect_exit 0 "$NERAF" auralize --run "$R" --mic "$MIC" --src "$SRC" --yaw 90 \
   --in "$ASSETS/real/castanets_dry.wav" --out "$TMP/wet.wav" --normalize
 expect_exit 0 "$NERAF" metrics --rir "$TMP/wet.wav"
+
+# --- export → the runtime (neraf_rt) gives the run's numbers -----------------------------------
+EX=$(cd "$(dirname "$0")/../../examples/paths" && pwd)
+M=$TMP/m.nrf
+expect_exit 0 "$NERAF" export --run "$R" --out "$M"
+expect_in "$TMP/out" "runtime vs LibTorch"
+expect_exit 0 "$NERAF" export --run "$R" --out "$TMP/m16.nrf" --precision bf16
+[ "$(stat -c %s "$TMP/m16.nrf")" -lt "$(stat -c %s "$M")" ] || fail "bf16 export is not smaller"
+expect_exit 0 "$NERAF" eval --run "$R" --json "$TMP/e_run.json" --skip-vision --max-rirs 4 --no-images --quiet
+expect_exit 0 "$NERAF" eval --model "$M" --json "$TMP/e_model.json" --max-rirs 4 --no-images --quiet
+python3 - "$TMP/e_run.json" "$TMP/e_model.json" <<'PY' || fail "eval --model differs from eval --run"
+import json, sys
+a, b = (json.load(open(p))["audio"] for p in sys.argv[1:])
+for method in ("neraf", "nearest", "linear"):
+    for key in ("t60_error_pct", "c50_error_db", "edt_error_s", "stft_error"):
+        x, y = a[method][key], b[method][key]
+        assert abs(x - y) <= 1e-3 * (1 + abs(x)), (method, key, x, y)
+PY
+expect_exit 0 "$NERAF" render rir --model "$M" --mic "$MIC" --src "$SRC" --yaw 90 --out "$TMP/rir_m.wav"
+expect_exit 0 "$NERAF" render loudness --model "$M" --src "$SRC" --spacing 0.5 --out "$TMP/map_m.png"
+expect_exit 0 "$NERAF" auralize --model "$M" --mic "$MIC" --src "$SRC" --yaw 90 \
+  --in "$ASSETS/real/castanets_dry.wav" --out "$TMP/wet_m.wav"
+expect_exit 1 "$NERAF" render rir --model "$M" --mic 40,1.5,2.5 --src "$SRC" --out "$TMP/x.wav"
+expect_in "$TMP/err" "--allow-outside"
+head -c 1000 "$M" >"$TMP/cut.nrf"
+expect_exit 1 "$NERAF" render rir --model "$TMP/cut.nrf" --mic "$MIC" --src "$SRC" --out "$TMP/x.wav"
+expect_in "$TMP/err" "cut.nrf"
+[ ! -e "$TMP/x.wav" ] || fail "a failed render left $TMP/x.wav"
+expect_exit 2 "$NERAF" render rir --run "$R" --model "$M" --mic "$MIC" --src "$SRC" --out "$TMP/x.wav"
+
+# --- many poses, trajectories ------------------------------------------------------------------
+expect_exit 0 "$NERAF" render rir --model "$M" --poses "$EX/demo_poses.json" --out "$TMP/rirs"
+expect_file "$TMP/rirs/summary.csv"
+expect_file "$TMP/rirs/near_source.wav"
+expect_file "$TMP/rirs/pose_0005.wav"
+[ "$(wc -l <"$TMP/rirs/summary.csv")" -eq 8 ] || fail "summary.csv: expected a header and 7 rows"
+expect_exit 1 "$NERAF" render rir --model "$M" --poses "$EX/demo_poses.json" --out "$TMP/rirs"
+expect_in "$TMP/err" "not an empty folder"
+printf '{"version":1,"source":[1,1,1],"poses":[{"mic":[1,NaN,1]}]}' >"$TMP/nan.json"
+expect_exit 1 "$NERAF" render rir --model "$M" --poses "$TMP/nan.json" --out "$TMP/rirs_nan"
+[ ! -e "$TMP/rirs_nan" ] || fail "a failed --poses left a folder"
+expect_exit 0 "$NERAF" render trajectory --model "$M" --path "$EX/demo_walk.json" \
+  --in "$ASSETS/real/castanets_dry.wav" --out "$TMP/walk.wav" --rate 10
+expect_in "$TMP/out" "RIRs from"
+expect_exit 0 "$NERAF" metrics --rir "$TMP/walk.wav"
+expect_exit 0 "$NERAF" render trajectory --run "$R" --path "$EX/demo_walk.json" \
+  --in "$ASSETS/real/castanets_dry.wav" --out "$TMP/walk_run.wav" --rate 2 --frames "$TMP/frames" --fps 0.5
+expect_file "$TMP/frames/frame_00000.png"
+printf '{"version":1,"source":[1.1,1.2,0.9],"keyframes":[{"time":1,"mic":[2,1.5,2],"yaw":0},{"time":0.5,"mic":[2,1.5,2],"yaw":0}]}' >"$TMP/back.json"
+expect_exit 1 "$NERAF" render trajectory --model "$M" --path "$TMP/back.json" \
+  --in "$ASSETS/real/castanets_dry.wav" --out "$TMP/x.wav"
+expect_in "$TMP/err" "back.json"
+printf '{"version":1,"source":[1.1,1.2,0.9],"keyframes":[{"time":0,"mic":[40,1.5,2],"yaw":0}]}' >"$TMP/far.json"
+expect_exit 1 "$NERAF" render trajectory --model "$M" --path "$TMP/far.json" \
+  --in "$ASSETS/real/castanets_dry.wav" --out "$TMP/x.wav"
+expect_in "$TMP/err" "--allow-outside"
+expect_exit 2 "$NERAF" render trajectory --model "$M" --path "$EX/demo_walk.json" \
+  --in "$ASSETS/real/castanets_dry.wav" --out "$TMP/x.wav" --block 0
+expect_exit 1 "$NERAF" render trajectory --model "$M" --path "$EX/demo_walk.json" \
+  --in "$ASSETS/real/castanets_dry.wav" --out "$TMP/x.wav" --frames "$TMP/f2"
+expect_in "$TMP/err" "--frames"
 
 # --- a vision-only run has no acoustic field --------------------------------------------------
 expect_exit 0 "$NERAF" train --data "$S" --modality vision --out "$TMP/vis" --steps 2 --rays 256 --quiet

@@ -10,7 +10,7 @@
 #include <limits>
 #include <sstream>
 
-#include "neraf/train/audio_run.h"
+#include "neraf/infer/audio_run.h"
 #include "neraf/util/error.h"
 
 namespace neraf::render {
@@ -96,7 +96,7 @@ TEST(Loudness, RmsMatchesLibrosaFormulaByHand) {
 
 TEST(Loudness, MagnitudeClipping) {
   // exp(x) − 1e-3 clipped to [0, 1e4]: very negative → 0, very large → 1e4.
-  const torch::Tensor m = train::log_stft_to_magnitude(torch::tensor({-20.0f, 20.0f, 0.0f}));
+  const torch::Tensor m = infer::log_stft_to_magnitude(torch::tensor({-20.0f, 20.0f, 0.0f}));
   EXPECT_FLOAT_EQ(m[0].item<float>(), 0.0f);
   EXPECT_FLOAT_EQ(m[1].item<float>(), 1e4f);
   EXPECT_NEAR(m[2].item<float>(), 0.999f, 1e-6);

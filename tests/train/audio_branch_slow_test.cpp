@@ -4,12 +4,15 @@
 
 #include <numeric>
 
-#include "audio_test_util.h"
+#include "../infer/audio_test_util.h"
 #include "neraf/train/audio_branch.h"
 #include "neraf/train/trainer.h"
 
 namespace neraf::train {
 namespace {
+
+using infer::TrainConfig;
+namespace fixtures = infer::fixtures;
 
 TEST(AudioBranchSlow, JointTrainingReducesTheAudioLoss) {
   torch::manual_seed(0);

@@ -1,29 +1,24 @@
-// The acoustic branch in the trainer: checkpoint round trip, dataset/preset mismatch errors,
-// few-shot subsets, baseline neighbour selection, and the eval JSON/CSV/PNG outputs.
+// The acoustic branch in the trainer: checkpoint round trip and dataset/preset mismatch errors.
+// (Few-shot subsets and loading: tests/infer/audio_run_test.cpp; baselines and the eval outputs:
+// tests/eval/audio_eval_test.cpp.)
 #include "neraf/train/audio_branch.h"
 
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
-#include <filesystem>
-#include <fstream>
-
-#include "audio_test_util.h"
-#include "neraf/io/json_file.h"
-#include "neraf/train/audio_eval.h"
-#include "neraf/train/audio_run.h"
-#include "neraf/train/checkpoint.h"
+#include "../infer/audio_test_util.h"
+#include "neraf/infer/checkpoint.h"
 #include "neraf/train/trainer.h"
 #include "neraf/util/error.h"
 
 namespace neraf::train {
 namespace {
 
-namespace fs = std::filesystem;
-using fixtures::make_image_set;
-using fixtures::make_temp_dir;
-using fixtures::tiny_joint_config;
-using fixtures::tiny_rir_set;
+using infer::TrainConfig;
+using infer::fixtures::make_image_set;
+using infer::fixtures::make_temp_dir;
+using infer::fixtures::tiny_joint_config;
+using infer::fixtures::tiny_rir_set;
 
 TEST(AudioBranch, JointStepReportsAudioLossesAndTouchesTheGrid) {
   torch::manual_seed(0);
@@ -114,173 +109,13 @@ TEST(AudioBranch, MismatchedDatasetOrPresetIsAClearError) {
   }
   // Another preset (or grid mode) is refused by the header check.
   torch::serialize::InputArchive arch;
-  load_archive(arch, path);
+  infer::load_archive(arch, path);
   TrainConfig other = c;
   other.audio.grid = "none";
-  EXPECT_THROW(check_checkpoint_header(arch, other, path), Error);
+  EXPECT_THROW(infer::check_checkpoint_header(arch, other, path), Error);
   TrainConfig paper = c;
   paper.preset = "paper";
-  EXPECT_THROW(check_checkpoint_header(arch, paper, path), Error);
-}
-
-TEST(AudioBranch, FewShotSubsetIsSeededAndSized) {
-  const std::string dir = make_temp_dir("subset");
-  const data::RirSet rirs = tiny_rir_set(dir);
-  ASSERT_EQ(rirs.train.size(), 5u);
-  EXPECT_EQ(audio_train_subset(rirs, 1.0, 1), rirs.train);
-  const auto s = audio_train_subset(rirs, 0.4, 7);
-  EXPECT_EQ(s.size(), 2u);
-  EXPECT_EQ(s, audio_train_subset(rirs, 0.4, 7));
-  EXPECT_TRUE(std::is_sorted(s.begin(), s.end()));
-  for (int64_t i : s)
-    EXPECT_NE(std::find(rirs.train.begin(), rirs.train.end(), i), rirs.train.end());
-  EXPECT_EQ(audio_train_subset(rirs, 0.01, 7).size(), 1u);
-  EXPECT_THROW(audio_train_subset(rirs, 0.0, 7), Error);
-}
-
-data::Rir hand_rir(double mx, double my, double mz, double sx, int heading) {
-  data::Rir r;
-  r.mic = {mx, my, mz};
-  r.source = {sx, 1.0, 0.0};
-  r.heading_deg = heading;
-  return r;
-}
-
-TEST(AudioBaselines, NearestPicksSameHeadingAndSourceClosestMic) {
-  data::RirSet set;
-  set.rirs = {
-      hand_rir(0.0, 1.0, 0.0, 5.0, 90),  // 0 query (test)
-      hand_rir(0.1, 1.0, 0.0, 5.0, 0),   // 1 closest mic but other heading
-      hand_rir(0.2, 1.0, 0.0, 4.0, 90),  // 2 close mic, other source
-      hand_rir(1.0, 1.0, 0.0, 5.0, 90),  // 3 same heading + source, far
-      hand_rir(0.0, 1.0, 0.6, 5.0, 90),  // 4 same heading + source, nearest of those (0.6)
-      hand_rir(0.0, 1.7, 0.0, 5.0, 90),  // 5 same heading + source (0.7)
-  };
-  const std::vector<int64_t> train = {1, 2, 3, 4, 5};
-  std::vector<double> d;
-  const auto nb = nearest_training_rirs(set, train, set.rirs[0], 4, &d);
-  ASSERT_EQ(nb.size(), 3u);  // only 3, 4, 5 qualify
-  EXPECT_EQ(nb[0], 4);
-  EXPECT_EQ(nb[1], 5);
-  EXPECT_EQ(nb[2], 3);
-  EXPECT_NEAR(d[0], 0.6, 1e-12);
-  EXPECT_NEAR(d[2], 1.0, 1e-12);
-  // Without any same-source candidate: same heading (mic + source distance) wins over others.
-  const auto nb2 = nearest_training_rirs(set, {1, 2}, set.rirs[0], 1, &d);
-  ASSERT_EQ(nb2.size(), 1u);
-  EXPECT_EQ(nb2[0], 2);
-  EXPECT_NEAR(d[0], 0.2 + 1.0, 1e-12);
-  // No same heading at all: the closest pose overall.
-  EXPECT_EQ(nearest_training_rirs(set, {1}, set.rirs[0], 1)[0], 1);
-}
-
-TEST(AudioEval, RunFolderPredictsAndWritesJsonCsvPng) {
-  torch::manual_seed(0);
-  const std::string dir = make_temp_dir("eval");
-  const data::RirSet rirs = tiny_rir_set(dir);
-  const data::ImageSet images = make_image_set();
-  const TrainConfig c = tiny_joint_config();
-  auto trainer = make_trainer(c, &images, torch::kCPU, &rirs);
-  trainer->step();
-  trainer->step();
-  const std::string run = dir + "/run";
-  trainer->save_checkpoint(checkpoint_path(run, 2));
-  io::write_json_atomically(run + "/config.json", to_json(c));
-  io::write_json_atomically(run + "/data.json", {{"audio", make_audio_manifest(rirs)}});
-
-  const AudioRun ar = load_audio_run(run);
-  EXPECT_EQ(ar.step(), 2);
-  EXPECT_EQ(ar.info().channels, 2);
-  EXPECT_EQ(ar.info().sample_rate, 22050);
-  const torch::Tensor p = ar.predict_log_stft(rirs.rirs[5].mic, rirs.rirs[5].source, 90.0);
-  EXPECT_EQ(p.sizes(), (std::vector<int64_t>{2, 257, rirs.max_len}));
-  EXPECT_TRUE(torch::isfinite(p).all().item<bool>());
-  const auto wave = ar.predict_waveform(rirs.rirs[5].mic, rirs.rirs[5].source, 90.0, 0, 1000);
-  ASSERT_EQ(wave.size(), 2u);
-  EXPECT_EQ(wave[0].size(), 1000u);
-
-  AudioEvalOptions o;
-  o.out_dir = dir + "/eval";
-  o.num_images = 1;
-  o.progress = false;
-  const AudioEval e = evaluate_audio(ar, rirs, rirs.train, o);
-  ASSERT_EQ(e.methods.size(), 3u);
-  const nlohmann::json j = to_json(e);
-  for (const char* m : {"neraf", "nearest", "linear"})
-    for (const char* k :
-         {"t60_error_pct", "c50_error_db", "edt_error_s", "stft_error", "invalid_t60", "n_rirs"})
-      EXPECT_TRUE(j.at(m).contains(k)) << m << "." << k;
-  EXPECT_EQ(j["neraf"]["n_rirs"], 2);
-  write_audio_csv(o.out_dir + "/audio_per_rir.csv", e);
-  std::ifstream csv(o.out_dir + "/audio_per_rir.csv");
-  int lines = 0;
-  for (std::string l; std::getline(csv, l);) ++lines;
-  EXPECT_EQ(lines, 1 + 3 * 2);
-  EXPECT_TRUE(fs::exists(o.out_dir + "/audio_00000.png"));
-  EXPECT_NE(audio_table(e.methods).find("nearest"), std::string::npos);
-
-  // Any RIRs of a set in the same format (here: training RIRs, scored as if new): the same
-  // prediction as the default split's path gives for them, baselines from the run's train set.
-  const std::vector<int64_t> chosen = {rirs.train[0], rirs.train[1], rirs.train[2]};
-  const AudioEval n = evaluate_audio(ar, rirs, {rirs.train[3]}, rirs, chosen, o);
-  ASSERT_EQ(n.methods.size(), 3u);
-  EXPECT_EQ(n.rir_ids.size(), 3u);
-  EXPECT_EQ(n.rir_ids[1], rirs.rirs[static_cast<size_t>(chosen[1])].id);
-  EXPECT_EQ(to_json(n)["linear"]["n_rirs"], 3);
-  nlohmann::json manifest = make_audio_manifest(rirs);
-  EXPECT_NO_THROW(check_same_room_format(manifest, rirs, "novel"));
-  manifest["num_rirs"] = 1;  // another set of the same room: fine
-  EXPECT_NO_THROW(check_same_room_format(manifest, rirs, "novel"));
-  manifest["sample_rate"] = 48000;
-  try {
-    check_same_room_format(manifest, rirs, "novel");
-    ADD_FAILURE() << "a different sample rate must be refused";
-  } catch (const Error& err) {
-    EXPECT_NE(std::string(err.what()).find("sample_rate"), std::string::npos) << err.what();
-  }
-}
-
-// Paired neraf − baseline differences on hand-made per-RIR errors.
-TEST(AudioEval, PairedDifferencesAgainstEachBaseline) {
-  auto method = [](const std::string& name, std::vector<double> c50) {
-    AudioMethodEval m{name, {}, {}};
-    for (double v : c50) {
-      metrics::RirErrors r;
-      r.c50_error_db = v;
-      r.t60_error_pct = 2.0;  // a tie on T60
-      m.per_rir.push_back(r);
-    }
-    return m;
-  };
-  AudioEval e;
-  e.rir_ids = {"a", "b", "c"};
-  e.methods = {method("neraf", {0.5, 0.5, 1.0}), method("nearest", {1.0, 1.5, 1.5}),
-               method("linear", {0.5, 1.0, 0.5})};
-  const nlohmann::json j = paired_to_json(e);
-  // nearest: differences −0.5, −1, −0.5 → mean −2/3, s.d. √(1/12), s.e. √(1/12)/√3 = 1/6.
-  EXPECT_NEAR(j["nearest"]["c50_error_db"]["mean_difference"].get<double>(), -2.0 / 3.0, 1e-12);
-  EXPECT_NEAR(j["nearest"]["c50_error_db"]["standard_error"].get<double>(), 1.0 / 6.0, 1e-12);
-  EXPECT_EQ(j["nearest"]["c50_error_db"]["neraf_better"], 3);
-  EXPECT_EQ(j["nearest"]["c50_error_db"]["n"], 3);
-  // linear: 0, −0.5, +0.5 → mean 0, one RIR where neraf is better.
-  EXPECT_NEAR(j["linear"]["c50_error_db"]["mean_difference"].get<double>(), 0.0, 1e-12);
-  EXPECT_EQ(j["linear"]["c50_error_db"]["neraf_better"], 1);
-  EXPECT_EQ(j["linear"]["t60_error_pct"]["neraf_better"], 0);
-  EXPECT_TRUE(j["linear"]["edt_error_s"].contains("standard_error"));
-  const std::string table = paired_table(e);
-  EXPECT_NE(table.find("linear"), std::string::npos);
-  EXPECT_NE(table.find("C50 -0.667"), std::string::npos) << table;
-  // Without baselines (e.g. eval --no-baselines) there is nothing to pair.
-  e.methods.resize(1);
-  EXPECT_TRUE(paired_to_json(e).empty());
-  EXPECT_EQ(paired_table(e), "");
-}
-
-TEST(AudioRun, VisionRunHasNoAcousticField) {
-  const std::string dir = make_temp_dir("visiononly");
-  TrainConfig c = fixtures::tiny_train_config();
-  io::write_json_atomically(dir + "/config.json", to_json(c));
-  EXPECT_THROW(load_audio_run(dir), Error);
+  EXPECT_THROW(infer::check_checkpoint_header(arch, paper, path), Error);
 }
 
 }  // namespace

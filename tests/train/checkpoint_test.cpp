@@ -1,29 +1,32 @@
-#include "neraf/train/lr_schedule.h"
-#include "neraf/train/checkpoint.h"
+// Trainer checkpoints: exact resume, broken files and other configs refused, same seed same
+// numbers. (Checkpoint names: tests/infer/run_test.cpp.)
+#include "neraf/infer/checkpoint.h"
 
 #include <gtest/gtest.h>
 #include <torch/torch.h>
-
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 
+#include "../infer/synthetic_scene.h"
+#include "neraf/train/lr_schedule.h"
 #include "neraf/train/trainer.h"
 #include "neraf/util/error.h"
-#include "synthetic_scene.h"
 
 namespace fs = std::filesystem;
 using namespace neraf::train;
+using neraf::infer::Modality;
+using neraf::infer::TrainConfig;
+namespace fixtures = neraf::infer::fixtures;
 
 namespace {
 
 struct TempDir {
   fs::path path;
   TempDir() {
-    path = fs::temp_directory_path() /
-           ("neraf_ckpt_test_" + std::to_string(::getpid()) + "_" +
-            std::to_string(reinterpret_cast<uintptr_t>(this)));
+    path = fs::temp_directory_path() / ("neraf_ckpt_test_" + std::to_string(::getpid()) + "_" +
+                                        std::to_string(reinterpret_cast<uintptr_t>(this)));
     fs::create_directories(path);
   }
   ~TempDir() {
@@ -47,19 +50,6 @@ bool same(const std::vector<torch::Tensor>& a, const std::vector<torch::Tensor>&
 }
 
 }  // namespace
-
-TEST(Checkpoint, Names) {
-  EXPECT_EQ(fs::path(checkpoint_path("run", 1000)).filename().string(), "step-000001000.pt");
-  EXPECT_EQ(checkpoint_step_from_name("run/checkpoints/step-000001000.pt"), 1000);
-  EXPECT_EQ(checkpoint_step_from_name("run/checkpoints/step-1000.pt"), -1);
-  EXPECT_EQ(checkpoint_step_from_name("step-000001000.pt.tmp-12"), -1);
-  TempDir d;
-  EXPECT_FALSE(latest_checkpoint(d.path.string()).has_value());
-  fs::create_directories(checkpoint_dir(d.path.string()));
-  for (int64_t s : {5, 120, 40}) std::ofstream(checkpoint_path(d.path.string(), s)) << "x";
-  std::ofstream(checkpoint_dir(d.path.string()) + "/step-000000999.pt.tmp-1") << "x";
-  EXPECT_EQ(latest_checkpoint(d.path.string()).value(), checkpoint_path(d.path.string(), 120));
-}
 
 TEST(Checkpoint, SaveLoadRoundTripAndExactResume) {
   const auto images = fixtures::make_image_set();
@@ -185,19 +175,4 @@ TEST(Trainer, AudioModalityIsNotAvailableYet) {
   TrainConfig cfg = fixtures::tiny_train_config();
   cfg.modality = Modality::joint;
   EXPECT_THROW(make_trainer(cfg, &images, torch::kCPU), neraf::Error);
-}
-
-TEST(TrainConfig, JsonRoundTrip) {
-  for (const char* name : {"cpu", "paper"}) {
-    TrainConfig c = train_preset(name);
-    c.seed = 1234;
-    const auto j = to_json(c);
-    const TrainConfig back = train_config_from_json(j, "test");
-    EXPECT_EQ(to_json(back), j);
-    EXPECT_EQ(j["model"]["field"]["grid"]["log2_hashmap_size"],
-              std::string(name) == "paper" ? 19 : 17);
-  }
-  EXPECT_THROW(train_config_from_json(nlohmann::json::parse(R"({"preset": "gpu"})"), "x"),
-               neraf::Error);
-  EXPECT_THROW(train_config_from_json(nlohmann::json::parse(R"({"stepz": 3})"), "x"), neraf::Error);
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 
 using namespace neraf::train;
+using namespace neraf::infer;
 
 TEST(LrSchedule, NerfactoFieldsDecay) {
   ScheduleConfig s;  // 1e-2 → 1e-4 over 200k steps

@@ -2,10 +2,11 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include "../infer/synthetic_scene.h"
 #include "neraf/train/trainer.h"
-#include "synthetic_scene.h"
 
 using namespace neraf::train;
+using namespace neraf::infer;
 
 TEST(Overfit, FortyStepsReduceTheLoss) {
   const auto images = fixtures::make_image_set(2, 8);

@@ -42,8 +42,8 @@ AcousticModelOptions acoustic_preset(const std::string& name, int64_t n_channels
     o.grid.cells_per_update = 1024;
     o.resnet = resnet3d_cpu_options();
     o.nacf = nacf_cpu_options(n_channels, n_freq, resnet3d_out_features(o.resnet));
-    o.nacf.bf16 = true;               // training follows --precision (train::audio_model_options)
-    o.nacf.relative_geometry = true;  // extent_m from the data (train::audio_model_options)
+    o.nacf.bf16 = true;               // training follows --precision (infer::audio_model_options)
+    o.nacf.relative_geometry = true;  // extent_m from the data (infer::audio_model_options)
     o.nacf.position_max_freq_exp = 1.0;  // room-scale positions (train_config.cpp says why)
   } else {
     throw Error("preset: unknown acoustic preset '" + name + "': use cpu or paper");
@@ -82,7 +82,7 @@ torch::Tensor AcousticModelImpl::forward_with_feature(const torch::Tensor& featu
                                                       const torch::Tensor& t,
                                                       const torch::Tensor& mic_norm,
                                                       const torch::Tensor& src_norm,
-                                                      const torch::Tensor& rot) {
+                                                      const torch::Tensor& rot) const {
   return field_->forward(nacf_input(options_.nacf, feature, t, options_.max_len, mic_norm, src_norm,
                                     rot));  // [B, C, F]
 }
@@ -118,9 +118,8 @@ torch::Tensor pose_row(const torch::Tensor& x, const char* name) {
 torch::Tensor AcousticModelImpl::render_stft_with_feature(const torch::Tensor& feature,
                                                           const torch::Tensor& mic_norm,
                                                           const torch::Tensor& src_norm,
-                                                          const torch::Tensor& rot) {
-  torch::NoGradGuard no_grad;
-  EvalScope eval(*this);
+                                                          const torch::Tensor& rot) const {
+  torch::NoGradGuard no_grad;  // thread-local; NAcF needs no eval mode (no BatchNorm or dropout)
   const int64_t n = options_.max_len;
   const auto device = field_->parameters().front().device();
   const auto t = torch::arange(n, torch::dtype(torch::kInt64).device(device));

@@ -57,19 +57,24 @@ class AcousticModelImpl : public torch::nn::Module {
   torch::Tensor forward(const torch::Tensor& grid, const torch::Tensor& t,
                         const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
                         const torch::Tensor& rot);
-  // Same with a precomputed scene feature ([G], or undefined for kNone).
+  // Same with a precomputed scene feature ([G], or undefined for kNone). Runs NAcF only, which
+  // has no BatchNorm or dropout: the same in either mode, and reads no module state but the
+  // parameters.
   torch::Tensor forward_with_feature(const torch::Tensor& feature, const torch::Tensor& t,
                                      const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
-                                     const torch::Tensor& rot);
+                                     const torch::Tensor& rot) const;
 
   // All frames t = 0..max_len−1 of one pose (mic_norm, src_norm, rot: [3] or [1, 3]) → [C, F, T].
   // No autograd, ResNet3D and NAcF in eval mode (the previous mode is restored), one batch of T.
   torch::Tensor render_stft(const torch::Tensor& grid, const torch::Tensor& mic_norm,
                             const torch::Tensor& src_norm, const torch::Tensor& rot);
-  // Same from a scene feature computed once (in eval mode) for many RIRs.
+  // Same from a scene feature computed once (in eval mode) for many RIRs: the inference query.
+  // NAcF only, so no train/eval switch is needed and none is made; with the thread-local
+  // NoGradGuard it touches no shared state and may run from several threads at once.
   torch::Tensor render_stft_with_feature(const torch::Tensor& feature,
                                          const torch::Tensor& mic_norm,
-                                         const torch::Tensor& src_norm, const torch::Tensor& rot);
+                                         const torch::Tensor& src_norm,
+                                         const torch::Tensor& rot) const;
 
   const AcousticModelOptions& options() const { return options_; }
   // Null for GridMode::kNone.

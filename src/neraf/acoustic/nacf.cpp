@@ -146,7 +146,7 @@ NacfImpl::NacfImpl(NacfOptions options) : options_(std::move(options)) {
   }
 }
 
-torch::Tensor NacfImpl::forward(const torch::Tensor& h_in) {
+torch::Tensor NacfImpl::forward(const torch::Tensor& h_in) const {
   TORCH_CHECK(h_in.dim() == 2 && h_in.size(1) == options_.in_features(), "Nacf: expected [B, ",
               options_.in_features(), "], got ", h_in.sizes());
   const auto lowp = torch::kBFloat16;

@@ -107,8 +107,10 @@ class NacfImpl : public torch::nn::Module {
  public:
   explicit NacfImpl(NacfOptions options = {});
 
-  // h: [B, in_features] float32 → [B, C, F] in (−output_scale, output_scale).
-  torch::Tensor forward(const torch::Tensor& h);
+  // h: [B, in_features] float32 → [B, C, F] in (−output_scale, output_scale). Reads the
+  // parameters only (no BatchNorm or dropout: the same in train and eval mode), so concurrent
+  // calls are safe.
+  torch::Tensor forward(const torch::Tensor& h) const;
 
   const NacfOptions& options() const { return options_; }
   int64_t trunk_parameter_count() const;

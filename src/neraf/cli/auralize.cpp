@@ -20,7 +20,7 @@ namespace {
 
 struct AuralizeArgs {
   std::string rir_path;
-  std::string run_dir;  // model mode: render the RIR from a trained run instead of --rir
+  FieldArgs field;  // render the RIR from a trained field (--run or --model) instead of --rir
   AudioPoseArgs pose;
   std::string dry_path;
   std::string out_path;
@@ -87,21 +87,21 @@ void register_auralize(CLI::App& app) {
       "convolved. Dry audio at another sample rate is resampled to the RIR's rate. The output\n"
       "has len(dry) + len(rir) - 1 samples and is written as a 32-bit float WAV (.flac: 24-bit\n"
       "FLAC).\n"
-      "Give the impulse response as a file (--rir) or as a pose in a trained run (--run with\n"
-      "--mic, --src and the orientation): the RIR is then rendered exactly as 'neraf render rir'.");
-  cmd->footer("With --run:\n" + audio_pose_help() +
+      "Give the impulse response as a file (--rir) or as a pose in a trained field (--run or\n"
+      "--model with --mic, --src and the orientation): the RIR is then rendered exactly as\n"
+      "'neraf render rir'. For a moving listener see 'neraf render trajectory'.");
+  cmd->footer("With --run or --model:\n" + audio_pose_help() +
               "Example: neraf auralize --run runs/demo --mic 2.0,1.5,1.6 --src 1.1,1.2,0.9 "
               "--yaw 90 --in speech.wav --out speech_in_room.wav --normalize");
   CLI::Option* rir_opt = cmd->add_option(
       "--rir", args->rir_path,
       "Room impulse response to convolve with: WAV/FLAC, mono or multichannel, e.g. a measured "
       "RIR or one rendered by 'neraf render rir' (this or --run)");
-  CLI::Option* run_opt = cmd->add_option(
-      "--run", args->run_dir,
-      "Trained run (joint or audio) whose acoustic field gives the RIR at --mic/--src (this or "
-      "--rir)");
-  rir_opt->excludes(run_opt);
-  const auto pose_opts = add_audio_pose_options(cmd, args->pose, true, false, run_opt);
+  add_field_options(cmd, args->field, true);
+  CLI::Option* run_opt = args->field.run_opt;
+  CLI::Option* model_opt = args->field.model_opt;
+  rir_opt->excludes(run_opt)->excludes(model_opt);
+  const auto pose_opts = add_audio_pose_options(cmd, args->pose, true, false);
   cmd->add_option(
          "--in", args->dry_path,
          "Dry audio to place in the room (WAV/FLAC, mono, stereo, or as many channels as the RIR)")
@@ -110,21 +110,23 @@ void register_auralize(CLI::App& app) {
   cmd->add_flag("--normalize", args->normalize,
                 "Scale the result so its peak is 0.99 (same gain on all channels). Without it the "
                 "level is kept and a warning is printed if the result would clip");
-  cmd->callback([args, rir_opt, run_opt, pose_opts] {
-    // Checked here rather than with ->required(): --rir and --run are alternatives; still usage
-    // errors (exit 2).
-    if (rir_opt->count() == 0 && run_opt->count() == 0) {
-      throw CLI::RequiredError("--rir or --run");
-    }
-    if (run_opt->count() > 0) {
-      if (pose_opts.first->count() == 0) throw CLI::RequiredError("--mic (with --run)");
-      if (pose_opts.second->count() == 0) throw CLI::RequiredError("--src (with --run)");
+  cmd->callback([args, rir_opt, run_opt, model_opt, pose_opts] {
+    // Checked here rather than with ->required(): --rir, --run and --model are alternatives;
+    // still usage errors (exit 2).
+    const bool field = run_opt->count() > 0 || model_opt->count() > 0;
+    if (rir_opt->count() == 0 && !field) throw CLI::RequiredError("--rir, --run or --model");
+    if (field) {
+      if (pose_opts.first->count() == 0) throw CLI::RequiredError("--mic (with --run/--model)");
+      if (pose_opts.second->count() == 0) throw CLI::RequiredError("--src (with --run/--model)");
+      const LoadedField loaded = load_field(args->field);
       std::string summary;
-      const io::AudioBuffer rir = render_rir_from_run(args->run_dir, args->pose, &summary);
+      const io::AudioBuffer rir = render_rir_from_field(loaded, args->field, args->pose, &summary);
       info("rendered the RIR: " + summary);
-      auralize_and_write(rir, "rendered from " + args->run_dir, args->dry_path, *args);
+      auralize_and_write(rir, "rendered from " + loaded.name, args->dry_path, *args);
       return;
     }
+    if (pose_opts.first->count() + pose_opts.second->count() > 0)
+      throw CLI::ValidationError("--mic/--src: only with --run or --model (a field to render)");
     const io::AudioBuffer rir = io::read_audio(args->rir_path);
     auralize_and_write(rir, args->rir_path, args->dry_path, *args);
   });

@@ -13,5 +13,6 @@ void register_render(CLI::App& app);
 void register_eval(CLI::App& app);
 void register_info(CLI::App& app);
 void register_synth(CLI::App& app);
+void register_export(CLI::App& app);
 
 }  // namespace neraf::cli

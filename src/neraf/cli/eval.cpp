@@ -15,13 +15,13 @@
 
 #include "neraf/cli/commands.h"
 #include "neraf/data/image_set.h"
+#include "neraf/eval/audio_eval.h"
+#include "neraf/eval/evaluation.h"
+#include "neraf/infer/audio_run.h"
+#include "neraf/infer/exported_model.h"
+#include "neraf/infer/run.h"
 #include "neraf/io/json_file.h"
 #include "neraf/sim/synthesize.h"
-#include "neraf/train/audio_branch.h"
-#include "neraf/train/audio_eval.h"
-#include "neraf/train/audio_run.h"
-#include "neraf/train/evaluation.h"
-#include "neraf/train/run.h"
 #include "neraf/util/error.h"
 
 namespace neraf::cli {
@@ -30,6 +30,7 @@ namespace {
 
 struct EvalArgs {
   std::string run;
+  std::string model;  // an exported MODEL.nrf instead of --run (audio only)
   std::string json;
   std::string images;
   std::string data;
@@ -67,24 +68,23 @@ struct AudioEvalSet {
 
 // The run, its baselines and the ablation runs on one set; prints the table under `title`, writes
 // the per-RIR CSV into opts.out_dir as `csv_name` → {"neraf", "nearest", "linear", "ablations"}.
-nlohmann::json score_audio(const train::AudioRun& run,
-                           const std::vector<std::pair<std::string, train::AudioRun>>& ablations,
-                           const AudioEvalSet& set, const train::AudioEvalOptions& opts,
+nlohmann::json score_audio(const infer::AudioField& run,
+                           const std::vector<std::pair<std::string, infer::AudioRun>>& ablations,
+                           const AudioEvalSet& set, const eval::AudioEvalOptions& opts,
                            const std::string& csv_name, const std::string& title) {
-  train::AudioEval e =
-      train::evaluate_audio(run, set.train_set, set.train_subset, set.test_set, set.test, opts);
-  nlohmann::json out = train::to_json(e);
-  const nlohmann::json paired = train::paired_to_json(e);
+  eval::AudioEval e =
+      eval::evaluate_audio(run, set.train_set, set.train_subset, set.test_set, set.test, opts);
+  nlohmann::json out = eval::to_json(e);
+  const nlohmann::json paired = eval::paired_to_json(e);
   if (!paired.empty()) out["paired"] = paired;
   if (!ablations.empty()) {
     nlohmann::json abl = nlohmann::json::object();
-    train::AudioEvalOptions o = opts;
+    eval::AudioEvalOptions o = opts;
     o.num_images = 0;
     for (const auto& [dir, other] : ablations) {
       const std::string label = std::filesystem::path(dir).filename().string();
-      train::AudioMethodEval m =
-          train::evaluate_audio_model(other, set.test_set, set.test, label, o);
-      abl[label] = train::to_json(m.summary);
+      eval::AudioMethodEval m = eval::evaluate_audio_model(other, set.test_set, set.test, label, o);
+      abl[label] = eval::to_json(m.summary);
       abl[label]["run"] = dir;
       abl[label]["grid"] = other.run().config.audio.grid;
       abl[label]["relative_geometry"] = other.run().config.audio.relative_geometry;
@@ -94,11 +94,11 @@ nlohmann::json score_audio(const train::AudioRun& run,
   }
   const std::string csv = (std::filesystem::path(opts.out_dir) / csv_name).string();
   std::filesystem::create_directories(opts.out_dir);
-  train::write_audio_csv(csv, e);
+  eval::write_audio_csv(csv, e);
   out["per_rir_csv"] = csv;
   std::printf("%s (%s, %zu RIRs, %.1f s; per-RIR CSV %s):\n%s%s", title.c_str(),
               data::to_string(set.test_set.layout), e.rir_ids.size(), e.seconds, csv.c_str(),
-              train::audio_table(e.methods).c_str(), train::paired_table(e).c_str());
+              eval::audio_table(e.methods).c_str(), eval::paired_table(e).c_str());
   return out;
 }
 
@@ -120,35 +120,46 @@ void check_same_gain(const std::string& run_data_dir, const std::string& novel_d
               "; re-synthesise it with `neraf synth ... --gain-from " + run_data_dir + "`");
 }
 
+// What scoring needs of the field beside its predictions: the run's data manifest, seed, audio
+// fraction and grid mode (from the run folder, or as an exported model recorded them).
+struct EvalField {
+  const infer::AudioField& field;
+  nlohmann::json manifest;  // RUN/data.json
+  uint64_t seed = 0;
+  double audio_fraction = 1;
+  std::string grid;
+  std::string default_out_dir;  // PNGs and CSVs without --images
+};
+
 // The acoustic field on the test RIRs (and, with --novel-data, on every RIR of another dataset of
 // the same room), with the nearest/linear baselines and the ablation runs.
-nlohmann::json evaluate_audio_json(const train::AudioRun& run, const EvalArgs& args) {
+nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args) {
+  const infer::AudioField& run = source.field;
   const std::string data_dir =
-      args.data.empty() ? run.run().manifest.at("data").get<std::string>() : args.data;
+      args.data.empty() ? source.manifest.at("data").get<std::string>() : args.data;
   const data::RirSet rirs = load_rirs(data_dir, !args.quiet);
-  train::check_audio_manifest(run.run().manifest.at("audio"), rirs, data_dir);
-  std::vector<std::pair<std::string, train::AudioRun>> ablations;
+  infer::check_audio_manifest(source.manifest.at("audio"), rirs, data_dir);
+  std::vector<std::pair<std::string, infer::AudioRun>> ablations;
   for (const std::string& dir : split_commas(args.ablation_runs)) {
-    ablations.emplace_back(dir, train::load_audio_run(dir, torch::kCPU));
-    train::check_audio_manifest(ablations.back().second.run().manifest.at("audio"), rirs,
+    ablations.emplace_back(dir, infer::load_audio_run(dir, torch::kCPU));
+    infer::check_audio_manifest(ablations.back().second.run().manifest.at("audio"), rirs,
                                 dir + "/data.json");
   }
-  train::AudioEvalOptions opts;
+  eval::AudioEvalOptions opts;
   opts.progress = !args.quiet;
   opts.baselines = !args.no_baselines;
-  opts.seed = run.run().config.seed;
-  opts.out_dir =
-      args.images.empty() ? (std::filesystem::path(args.run) / "eval").string() : args.images;
+  opts.seed = source.seed;
+  opts.out_dir = args.images.empty() ? source.default_out_dir : args.images;
   if (args.no_images) opts.num_images = 0;
   const std::vector<int64_t> subset =
-      train::audio_train_subset(rirs, run.run().config.audio.fraction, run.run().config.seed);
+      infer::audio_train_subset(rirs, source.audio_fraction, source.seed);
 
   require(!rirs.test.empty(), data_dir + ": the audio test split is empty; nothing to evaluate");
   // Checked before anything is scored or written.
   std::optional<data::RirSet> novel;
   if (!args.novel_data.empty()) {
     novel = load_rirs(args.novel_data, !args.quiet);
-    train::check_same_room_format(run.run().manifest.at("audio"), *novel, args.novel_data);
+    infer::check_same_room_format(source.manifest.at("audio"), *novel, args.novel_data);
     check_same_gain(data_dir, args.novel_data);
   }
   auto first_rirs = [&](std::vector<int64_t> rirs_to_score) {  // --max-rirs
@@ -158,7 +169,7 @@ nlohmann::json evaluate_audio_json(const train::AudioRun& run, const EvalArgs& a
   };
   nlohmann::json out = score_audio(run, ablations, {rirs, subset, rirs, first_rirs(rirs.test)},
                                    opts, "audio_per_rir.csv", "audio, held-out test split");
-  out["grid"] = run.run().config.audio.grid;
+  out["grid"] = source.grid;
   if (novel) {
     std::vector<int64_t> all(novel->rirs.size());
     std::iota(all.begin(), all.end(), int64_t{0});
@@ -171,30 +182,30 @@ nlohmann::json evaluate_audio_json(const train::AudioRun& run, const EvalArgs& a
   return out;
 }
 
-nlohmann::json evaluate_vision_json(train::LoadedRun& run, const EvalArgs& args) {
+nlohmann::json evaluate_vision_json(infer::LoadedRun& run, const EvalArgs& args) {
   const std::string data_dir =
       args.data.empty() ? run.manifest.at("data").get<std::string>() : args.data;
   data::ImageLoadOptions load;
   load.progress = !args.quiet;
   const data::ImageSet images = data::load_transforms_json(data_dir, load);
   // The eval cameras must be the ones the run was trained against (same normalisation).
-  const nlohmann::json now = train::make_data_manifest(images, data_dir);
+  const nlohmann::json now = infer::make_data_manifest(images, data_dir);
   for (const char* key : {"num_train", "eval_files", "world_scale"})
     require(now[key] == run.manifest[key],
             data_dir + ": differs from the dataset the run was trained on (" + key +
                 "); pass the original dataset with --data");
-  train::VisionEvalOptions opts;
+  eval::VisionEvalOptions opts;
   opts.chunk = run.config.eval_rays_per_chunk;
   opts.max_views = args.max_views;
   opts.progress = !args.quiet;
   if (!args.no_images)
     opts.image_dir =
         args.images.empty() ? (std::filesystem::path(args.run) / "eval").string() : args.images;
-  const train::VisionEval e = train::evaluate_vision(run.model, images.eval, opts);
+  const eval::VisionEval e = eval::evaluate_vision(run.model, images.eval, opts);
   std::printf("vision: PSNR %.3f dB  SSIM %.4f  over %lld eval views (%.1f s)%s%s\n", e.psnr,
               e.ssim, static_cast<long long>(e.n_views), e.seconds,
               opts.image_dir.empty() ? "" : "; GT|prediction images in ", opts.image_dir.c_str());
-  return train::to_json(e);
+  return eval::to_json(e);
 }
 
 }  // namespace
@@ -202,7 +213,9 @@ nlohmann::json evaluate_vision_json(train::LoadedRun& run, const EvalArgs& args)
 void register_eval(CLI::App& app) {
   auto args = std::make_shared<EvalArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "eval", "Evaluate a trained run on its held-out views (PSNR, SSIM) and write JSON");
+      "eval",
+      "Evaluate a trained run on its held-out views (PSNR, SSIM) and RIRs (T60, C50, EDT, STFT "
+      "error against the baselines), or an exported model on the RIRs, and write JSON");
   cmd->footer(
       "PSNR and SSIM follow nerfstudio's evaluation (torchmetrics semantics, mean over the\n"
       "eval views). The JSON has {\"run\", \"checkpoint\", \"step\", \"vision\": {\"psnr\",\n"
@@ -217,15 +230,23 @@ void register_eval(CLI::App& app) {
       "prediction | GT log-STFT) and audio_per_rir.csv go to RUN/eval/ (or --images DIR).\n"
       "The test split holds out (source, heading) pairs at trained microphone positions;\n"
       "--novel-data scores new positions too (audio.novel).\n"
+      "With --model (neraf export) only the audio is scored; PNGs and CSVs go to\n"
+      "MODEL_eval/ (or --images DIR).\n"
       "Example: neraf eval --run runs/demo --json runs/demo/eval.json");
-  cmd->add_option("--run", args->run, "Run folder made by neraf train")->required();
+  CLI::Option* run_opt = cmd->add_option("--run", args->run, "Run folder made by neraf train");
+  CLI::Option* model_opt = cmd->add_option(
+      "--model", args->model,
+      "Exported model made by neraf export, instead of --run: its acoustic field is scored "
+      "(audio only) with the run's dataset, seed and training subset recorded in the file");
+  run_opt->excludes(model_opt);
   cmd->add_option("--json", args->json, "Output JSON file")->required();
   cmd->add_option("--images", args->images, "Folder for the GT|prediction PNGs (default RUN/eval)");
   cmd->add_flag("--no-images", args->no_images, "Do not write the comparison PNGs");
   cmd->add_option("--data", args->data,
                   "Dataset folder (default: the one recorded in RUN/data.json)");
   cmd->add_option("--checkpoint", args->checkpoint,
-                  "A specific checkpoint file (default: the run's latest)");
+                  "A specific checkpoint file (default: the run's latest)")
+      ->needs(run_opt);
   cmd->add_option("--max-views", args->max_views, "Evaluate only the first N eval views")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", args->threads, "CPU threads (default: all cores)")
@@ -247,23 +268,49 @@ void register_eval(CLI::App& app) {
                   "audio_novel_per_rir.csv); the baselines still use the run's training RIRs");
   cmd->callback([args]() {
     if (args->threads > 0) torch::set_num_threads(args->threads);
+    if (args->run.empty() && args->model.empty()) throw CLI::RequiredError("--run or --model");
+    if (!args->model.empty()) {
+      const infer::ExportedModel model = infer::load_exported_model(args->model);
+      const nlohmann::json& meta = model.metadata();
+      require(meta.contains("data") && meta["data"].contains("audio"),
+              args->model + ": records no training data manifest; re-export it with neraf export");
+      EvalField source{model,
+                       meta["data"],
+                       meta.value("seed", uint64_t{0}),
+                       meta.value("audio_fraction", 1.0),
+                       meta.value("grid", std::string("sampled")),
+                       std::filesystem::path(args->model).replace_extension("").string() + "_eval"};
+      nlohmann::json out = {{"model", args->model},
+                            {"run", meta.value("run", std::string())},
+                            {"checkpoint", meta.value("checkpoint", std::string())},
+                            {"step", meta.value("step", int64_t{0})}};
+      out["audio"] = evaluate_audio_json(source, *args);
+      io::write_json_atomically(args->json, out);
+      return;
+    }
     const std::string config_path = (std::filesystem::path(args->run) / "config.json").string();
     std::error_code ec;
     require(std::filesystem::is_regular_file(config_path, ec),
             args->run + ": not a training run (no config.json); check --run");
-    const train::TrainConfig cfg =
-        train::train_config_from_json(io::read_json(config_path), config_path);
+    const infer::TrainConfig cfg =
+        infer::train_config_from_json(io::read_json(config_path), config_path);
     nlohmann::json out = {{"run", args->run}};
-    if (cfg.modality != train::Modality::vision) {
-      const train::AudioRun audio = train::load_audio_run(args->run, torch::kCPU, args->checkpoint);
+    if (cfg.modality != infer::Modality::vision) {
+      const infer::AudioRun audio = infer::load_audio_run(args->run, torch::kCPU, args->checkpoint);
       out["checkpoint"] = audio.run().checkpoint;
       out["step"] = audio.step();
-      out["audio"] = evaluate_audio_json(audio, *args);
+      const EvalField source{audio,
+                             audio.run().manifest,
+                             audio.run().config.seed,
+                             audio.run().config.audio.fraction,
+                             audio.run().config.audio.grid,
+                             (std::filesystem::path(args->run) / "eval").string()};
+      out["audio"] = evaluate_audio_json(source, *args);
     }
     if (!args->skip_vision) {
       // An audio-only run has no radiance field of its own: its --vision-run's is evaluated.
-      const bool own = cfg.modality != train::Modality::audio;
-      train::LoadedRun run = train::load_run(own ? args->run : cfg.audio.vision_run, torch::kCPU,
+      const bool own = cfg.modality != infer::Modality::audio;
+      infer::LoadedRun run = infer::load_run(own ? args->run : cfg.audio.vision_run, torch::kCPU,
                                              own ? args->checkpoint : "");
       if (!out.contains("checkpoint")) {
         out["checkpoint"] = run.checkpoint;

@@ -1,5 +1,6 @@
 // neraf: the one program. Parses the command line and dispatches to a subcommand.
 // Exit codes: 0 success, 1 runtime error (one "error: ..." line), 2 usage error (message + usage).
+#include <fftw3.h>
 #include <malloc.h>
 
 #include <CLI/CLI.hpp>
@@ -33,6 +34,9 @@ const CLI::App* selected_command(const CLI::App& app) {
 
 int main(int argc, char** argv) {
   tune_malloc();
+  // neraf_dsp and neraf_rt plan FFTs under their own locks; eval and render trajectory use both
+  // from several threads, so FFTW's (process-global) planner must be safe across them.
+  fftwf_make_planner_thread_safe();
   neraf::cli::use_all_cores();
   CLI::App app{
       "neraf: neural radiance and acoustic fields (NeRAF) on the CPU.\n"
@@ -47,6 +51,7 @@ int main(int argc, char** argv) {
   neraf::cli::register_train(app);
   neraf::cli::register_render(app);
   neraf::cli::register_eval(app);
+  neraf::cli::register_export(app);
   neraf::cli::register_info(app);
   neraf::cli::register_synth(app);
 

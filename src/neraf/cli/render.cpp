@@ -10,8 +10,8 @@
 
 #include "neraf/cli/commands.h"
 #include "neraf/cli/render_audio.h"
+#include "neraf/infer/run.h"
 #include "neraf/render/view.h"
-#include "neraf/train/run.h"
 #include "neraf/util/error.h"
 
 namespace neraf::cli {
@@ -53,15 +53,15 @@ void add_render_view(CLI::App& render) {
   cmd->callback([args, frame, pose]() {
     require(frame->count() + pose->count() == 1, "render view: give --frame I or --pose FILE");
     if (args->threads > 0) torch::set_num_threads(args->threads);
-    train::LoadedRun run = train::load_run(args->run, torch::kCPU, args->checkpoint);
+    infer::LoadedRun run = infer::load_run(args->run, torch::kCPU, args->checkpoint);
     render::Camera cam;
     if (frame->count()) {
       const int64_t n = run.manifest.at("num_eval").get<int64_t>();
       require(args->frame < n, "--frame " + std::to_string(args->frame) + ": the run has " +
-                                   std::to_string(n) + " eval frames (0.." +
-                                   std::to_string(n - 1) + ")");
-      cam.c2w = train::manifest_eval_poses(run.manifest)[args->frame];
-      cam.intrinsics = train::manifest_intrinsics(run.manifest, args->frame);
+                                   std::to_string(n) + " eval frames (0.." + std::to_string(n - 1) +
+                                   ")");
+      cam.c2w = infer::manifest_eval_poses(run.manifest)[args->frame];
+      cam.intrinsics = infer::manifest_intrinsics(run.manifest, args->frame);
     } else {
       cam = render::read_camera_file(args->pose, run.manifest);
     }
@@ -69,8 +69,7 @@ void add_render_view(CLI::App& render) {
         render::render_view(run, cam, args->out, args->depth, run.config.eval_rays_per_chunk);
     std::printf("rendered %dx%d view (step %lld) in %.2f s → %s%s%s\n", cam.intrinsics.width,
                 cam.intrinsics.height, static_cast<long long>(run.step), o.seconds,
-                args->out.c_str(), args->depth.empty() ? "" : ", depth → ",
-                args->depth.c_str());
+                args->out.c_str(), args->depth.empty() ? "" : ", depth → ", args->depth.c_str());
   });
 }
 

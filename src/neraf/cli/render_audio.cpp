@@ -3,22 +3,31 @@
 #include "neraf/cli/render_audio.h"
 
 #include <torch/torch.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "neraf/geometry/trajectory.h"
+#include "neraf/infer/audio_run.h"
+#include "neraf/infer/exported_model.h"
+#include "neraf/io/atomic_file.h"
 #include "neraf/render/loudness.h"
 #include "neraf/render/rir.h"
-#include "neraf/train/audio_run.h"
 #include "neraf/util/error.h"
 #include "neraf/util/log.h"
+#include "neraf/util/progress.h"
+
+namespace fs = std::filesystem;
 
 namespace neraf::cli {
 namespace {
@@ -45,7 +54,7 @@ geometry::Vec3 parse_flag_position(const std::string& text, const std::string& f
   }
 }
 
-render::AudioModelInfo model_info(const train::AudioRunInfo& i) {
+render::AudioModelInfo model_info(const infer::AudioRunInfo& i) {
   render::AudioModelInfo m;
   m.layout = i.layout;
   m.sample_rate = i.sample_rate;
@@ -56,9 +65,9 @@ render::AudioModelInfo model_info(const train::AudioRunInfo& i) {
   return m;
 }
 
-render::LogStftFn bind(const train::AudioRun& run) {
-  return [&run](const torch::Tensor& mic, const torch::Tensor& src, const torch::Tensor& yaw) {
-    return run.predict_log_stft_batch(mic, src, yaw);
+render::LogStftFn bind(const infer::AudioField& field) {
+  return [&field](const torch::Tensor& mic, const torch::Tensor& src, const torch::Tensor& yaw) {
+    return field.predict_log_stft_batch(mic, src, yaw);
   };
 }
 
@@ -84,16 +93,8 @@ double resolve_yaw(const AudioPoseArgs& a, data::AudioLayout layout, const std::
   return a.src_yaw;
 }
 
-void warn_outside(const geometry::Vec3& p, const std::string& flag, const data::Aabb& box) {
-  if (!render::inside_open_box(p, box)) {
-    warn(flag + " " + fmt3(p) + " is outside the run's audio bounding box (" + aabb_text(box) +
-         ", the train microphones ± 1 m); NeRAF replaces such a position by zeros, so the "
-         "prediction does not describe this position");
-  }
-}
-
 struct LoudnessArgs {
-  std::string run;
+  FieldArgs field;
   AudioPoseArgs pose;
   std::string out;
   std::string csv;
@@ -102,34 +103,115 @@ struct LoudnessArgs {
   int threads = 0;
 };
 
+// `render rir --poses POSES.json --out DIR`: DIR/<name>.wav per pose and DIR/summary.csv, built
+// in a temporary folder beside DIR and renamed into place, so a failure leaves no half-written DIR.
+void render_pose_list(const LoadedField& field, const FieldArgs& field_args,
+                      const AudioPoseArgs& pose_args, const std::string& poses_path,
+                      const std::string& out_dir) {
+  const std::vector<geometry::NamedPose> poses = geometry::load_pose_list(poses_path);
+  const infer::AudioRunInfo& info = field.field->info();
+  for (size_t i = 0; i < poses.size(); ++i) {
+    const std::string where =
+        poses_path + ": poses[" + std::to_string(i) + "] (" + poses[i].name + ")";
+    check_inside(poses[i].mic, where + " mic", info.aabb, field_args.allow_outside);
+    check_inside(poses[i].source, where + " source", info.aabb, field_args.allow_outside);
+  }
+  std::error_code ec;
+  const fs::path out = fs::path(out_dir).lexically_normal();
+  require(!fs::exists(out, ec) || (fs::is_directory(out, ec) && fs::is_empty(out, ec)),
+          out_dir + ": exists and is not an empty folder; choose a new --out folder or remove it");
+  const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");
+  require(fs::is_directory(parent, ec),
+          parent.string() + ": no such folder for --out; create it first");
+  const fs::path tmp = parent / ("." + out.filename().string() + ".tmp-" +
+                                 std::to_string(static_cast<long long>(getpid())));
+  fs::remove_all(tmp, ec);
+  fs::create_directory(tmp);
+  try {
+    std::string csv =
+        "name,file,mic_x,mic_y,mic_z,src_x,src_y,src_z,yaw_deg,channels,"
+        "sample_rate,duration_s,peak\n";
+    render::RirRenderOptions o;
+    o.seed = pose_args.seed;
+    Progress progress("render rir", static_cast<int64_t>(poses.size()),
+                      ProgressOptions{"RIR", 0.2, 10.0, true});
+    for (size_t i = 0; i < poses.size(); ++i) {
+      const geometry::NamedPose& p = poses[i];
+      const io::AudioBuffer rir =
+          render::render_rir(bind(*field.field), model_info(info), p.mic, p.source, p.yaw_deg, o);
+      const std::string file = p.name + ".wav";
+      io::write_audio((tmp / file).string(), rir);
+      float peak = 0;
+      for (const auto& ch : rir.channels)
+        for (float x : ch) peak = std::max(peak, std::abs(x));
+      char row[512];
+      std::snprintf(row, sizeof row, "%s,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%.6g,%.6g\n",
+                    p.name.c_str(), file.c_str(), p.mic.x, p.mic.y, p.mic.z, p.source.x, p.source.y,
+                    p.source.z, p.yaw_deg, rir.num_channels(), rir.sample_rate, rir.duration_s(),
+                    peak);
+      csv += row;
+      progress.update(static_cast<int64_t>(i) + 1);
+    }
+    progress.finish();
+    io::write_text_atomically((tmp / "summary.csv").string(), csv);
+    fs::remove(out, ec);  // an empty folder (checked above), or nothing
+    fs::rename(tmp, out);
+  } catch (...) {
+    fs::remove_all(tmp, ec);
+    throw;
+  }
+  std::printf("wrote %s: %zu RIRs (%s, step %lld) and summary.csv\n", out_dir.c_str(), poses.size(),
+              field.name.c_str(), static_cast<long long>(field.step));
+}
+
 void add_render_rir(CLI::App& render) {
   struct Args {
-    std::string run;
+    FieldArgs field;
     AudioPoseArgs pose;
+    std::string poses;
     std::string out;
     int threads = 0;
   };
   auto args = std::make_shared<Args>();
   CLI::App* cmd = render.add_subcommand(
-      "rir", "Render the room impulse response of a trained acoustic field at a pose (WAV)");
+      "rir",
+      "Render the room impulse response of a trained acoustic field at a pose (WAV), or at "
+      "every pose of a list (--poses: one WAV each and a summary CSV)");
   cmd->footer(
       audio_pose_help() +
       "\nThe predicted log-magnitude STFT becomes clip(exp(x) - 1e-3, 0, 1e4) and a waveform "
       "by\nGriffin-Lim (32 iterations, momentum 0.99, random phases from --seed), written "
       "as a\n32-bit float WAV at the run's sample rate (22050 Hz SoundSpaces, 2 channels "
       "binaural;\n48000 Hz RAF, mono), hop*(T-1) samples long.\n"
-      "Example: neraf render rir --run runs/demo --mic 2.0,1.5,1.6 --src 1.1,1.2,0.9 "
-      "--yaw 90 --out rir.wav");
-  cmd->add_option("--run", args->run, "Run folder made by neraf train (joint or audio)")
+      "--poses FILE: the pose list format of docs/PATH_FORMAT.md; --out is then a new folder\n"
+      "that receives <name>.wav per pose and summary.csv (name, file, mic, source, yaw,\n"
+      "channels, sample rate, duration, peak).\n"
+      "Examples:\n  neraf render rir --run runs/demo --mic 2.0,1.5,1.6 --src 1.1,1.2,0.9 "
+      "--yaw 90 --out rir.wav\n  neraf render rir --model demo.nrf --poses "
+      "examples/paths/demo_poses.json --out rirs/");
+  add_field_options(cmd, args->field, true);
+  const auto pose_opts = add_audio_pose_options(cmd, args->pose, true, false);
+  CLI::Option* poses_opt = cmd->add_option(
+      "--poses", args->poses, "A pose list (JSON, docs/PATH_FORMAT.md): render every pose");
+  poses_opt->excludes(pose_opts.first)->excludes(pose_opts.second);
+  poses_opt->excludes(args->pose.yaw_opt)->excludes(args->pose.src_yaw_opt);
+  cmd->add_option("--out", args->out, "Output WAV (written atomically); with --poses a new folder")
       ->required();
-  add_audio_pose_options(cmd, args->pose, true);
-  cmd->add_option("--out", args->out, "Output WAV (written atomically)")->required();
   cmd->add_option("--threads", args->threads, "CPU threads (default: all cores)")
       ->check(CLI::PositiveNumber);
-  cmd->callback([args] {
+  cmd->callback([args, pose_opts, poses_opt] {
     if (args->threads > 0) torch::set_num_threads(args->threads);
+    if (poses_opt->count() == 0) {
+      if (pose_opts.first->count() == 0) throw CLI::RequiredError("--mic (or --poses)");
+      if (pose_opts.second->count() == 0) throw CLI::RequiredError("--src (or --poses)");
+    }
+    const LoadedField field = load_field(args->field);
+    if (poses_opt->count() > 0) {
+      render_pose_list(field, args->field, args->pose, args->poses, args->out);
+      return;
+    }
     std::string summary;
-    const io::AudioBuffer rir = render_rir_from_run(args->run, args->pose, &summary);
+    const io::AudioBuffer rir = render_rir_from_field(field, args->field, args->pose, &summary);
     io::write_audio(args->out, rir);
     std::printf("wrote %s: %d ch, %d Hz, %.3f s; %s\n", args->out.c_str(), rir.num_channels(),
                 rir.sample_rate, rir.duration_s(), summary.c_str());
@@ -151,9 +233,9 @@ void add_render_loudness(CLI::App& render) {
       "the source as a white ring; the colour bar shows the log-loudness range. The raw values\n"
       "go to a CSV (x_m,y_m,z_m,log_loudness). For SoundSpaces runs --yaw is the heading of\n"
       "every microphone of the grid.\n"
-      "Example: neraf render loudness --run runs/demo --src 1.1,1.2,0.9 --out loudness.png");
-  cmd->add_option("--run", args->run, "Run folder made by neraf train (joint or audio)")
-      ->required();
+      "Example: neraf render loudness --run runs/demo --src 1.1,1.2,0.9 --out loudness.png\n"
+      "  (--model demo.nrf instead of --run: the exported model of neraf export)");
+  add_field_options(cmd, args->field, true);
   add_audio_pose_options(cmd, args->pose, false);
   cmd->add_option("--out", args->out, "Output PNG (written atomically)")->required();
   cmd->add_option("--csv", args->csv, "Where to write the values (default: --out with .csv)");
@@ -169,11 +251,10 @@ void add_render_loudness(CLI::App& render) {
   cmd->callback([args] {
     if (args->threads > 0) torch::set_num_threads(args->threads);
     const geometry::Vec3 src = parse_flag_position(args->pose.src, "--src");
-    const train::AudioRun run =
-        train::load_audio_run(args->run, torch::kCPU, args->pose.checkpoint);
-    const train::AudioRunInfo& info = run.info();
-    const double yaw = resolve_yaw(args->pose, info.layout, args->run);
-    warn_outside(src, "--src", info.aabb);
+    const LoadedField field = load_field(args->field);
+    const infer::AudioRunInfo& info = field.field->info();
+    const double yaw = resolve_yaw(args->pose, info.layout, field.name);
+    check_inside(src, "--src", info.aabb, args->field.allow_outside);
     render::FloorGridOptions go;
     go.spacing_m = args->spacing;
     go.height_m = args->height;
@@ -185,7 +266,7 @@ void add_render_loudness(CLI::App& render) {
     }
     const auto t0 = std::chrono::steady_clock::now();
     const render::LoudnessMap map =
-        render::compute_loudness_map(bind(run), grid, src, yaw, 64, true);
+        render::compute_loudness_map(bind(*field.field), grid, src, yaw, 64, true);
     const double secs =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const std::string csv = args->csv.empty() ? render::csv_path_for(args->out) : args->csv;
@@ -197,7 +278,7 @@ void add_render_loudness(CLI::App& render) {
         "%.2f m), log loudness %.3f..%.3f, %.1f s (step %lld)\n",
         args->out.c_str(), csv.c_str(), grid.x.size(), grid.z.size(), grid.x.front(), grid.x.back(),
         grid.z.front(), grid.z.back(), grid.height, grid.spacing, v.min().item<double>(),
-        v.max().item<double>(), secs, static_cast<long long>(run.step()));
+        v.max().item<double>(), secs, static_cast<long long>(field.step));
   });
 }
 
@@ -214,8 +295,9 @@ std::string audio_pose_help() {
          "    90 faces -x (Habitat). --src-yaw is an error (omnidirectional sources).\n"
          "  RAF runs: --src-yaw = the source yaw about +y (tx_pos.txt quaternion, as_euler('yxz')\n"
          "    [0]); --yaw is an error (omnidirectional microphones).\n"
-         "Positions outside the run's audio bounding box (train microphones +- 1 m) are zeroed\n"
-         "by NeRAF; a warning says so.\n";
+         "Positions outside the field's training box (train microphones +- 1 m) are an error:\n"
+         "NeRAF replaces such a position by zeros, so the prediction would not describe it;\n"
+         "--allow-outside renders anyway (with a warning).\n";
 }
 
 std::pair<CLI::Option*, CLI::Option*> add_audio_pose_options(CLI::App* cmd, AudioPoseArgs& a,
@@ -250,8 +332,6 @@ std::pair<CLI::Option*, CLI::Option*> add_audio_pose_options(CLI::App* cmd, Audi
     opts.push_back(cmd->add_option("--seed", a.seed,
                                    "Seed of Griffin-Lim's random initial phases (default 0)"));
   }
-  opts.push_back(cmd->add_option("--checkpoint", a.checkpoint,
-                                 "A specific checkpoint file (default: the run's latest)"));
   for (CLI::Option* o : opts) {
     if (required && (o == mic || o == src)) o->required();
     if (needs) o->needs(needs);
@@ -259,21 +339,66 @@ std::pair<CLI::Option*, CLI::Option*> add_audio_pose_options(CLI::App* cmd, Audi
   return {mic, src};
 }
 
-io::AudioBuffer render_rir_from_run(const std::string& run_dir, const AudioPoseArgs& args,
-                                    std::string* summary) {
+void add_field_options(CLI::App* cmd, FieldArgs& a, bool poses) {
+  a.run_opt = cmd->add_option("--run", a.run, "Run folder made by neraf train (joint or audio)");
+  a.model_opt = cmd->add_option("--model", a.model,
+                                "Exported model file made by neraf export (instead of --run)");
+  a.run_opt->excludes(a.model_opt);
+  cmd->add_option("--checkpoint", a.checkpoint,
+                  "A specific checkpoint file of --run (default: the run's latest)")
+      ->needs(a.run_opt);
+  if (poses) {
+    cmd->add_flag("--allow-outside", a.allow_outside,
+                  "Render poses outside the field's training box (train microphones +- 1 m) "
+                  "with a warning instead of an error");
+  }
+}
+
+LoadedField load_field(const FieldArgs& a) {
+  LoadedField out;
+  if (!a.model.empty()) {
+    auto model = std::make_unique<infer::ExportedModel>(infer::load_exported_model(a.model));
+    model->allow_outside(true);  // the commands check the poses themselves (check_inside)
+    out.step = model->metadata().value("step", int64_t{0});
+    out.name = a.model;
+    out.field = std::move(model);
+    return out;
+  }
+  if (a.run.empty()) throw CLI::RequiredError("--run or --model");
+  auto run =
+      std::make_unique<infer::AudioRun>(infer::load_audio_run(a.run, torch::kCPU, a.checkpoint));
+  out.step = run->step();
+  out.name = a.run;
+  out.field = std::move(run);
+  return out;
+}
+
+void check_inside(const geometry::Vec3& p, const std::string& what, const data::Aabb& box,
+                  bool allow_outside) {
+  if (render::inside_open_box(p, box)) return;
+  const std::string text = what + " " + fmt3(p) + " is outside the field's training box (" +
+                           aabb_text(box) +
+                           ", the train microphones +- 1 m); NeRAF replaces such a position by "
+                           "zeros, so the prediction would not describe it";
+  require(allow_outside, text + "; choose a position inside, or pass --allow-outside");
+  warn(text);
+}
+
+io::AudioBuffer render_rir_from_field(const LoadedField& field, const FieldArgs& field_args,
+                                      const AudioPoseArgs& args, std::string* summary) {
   const geometry::Vec3 mic = parse_flag_position(args.mic, "--mic");
   const geometry::Vec3 src = parse_flag_position(args.src, "--src");
-  const train::AudioRun run = train::load_audio_run(run_dir, torch::kCPU, args.checkpoint);
-  const train::AudioRunInfo& info = run.info();
-  const double yaw = resolve_yaw(args, info.layout, run_dir);
-  warn_outside(mic, "--mic", info.aabb);
-  warn_outside(src, "--src", info.aabb);
+  const infer::AudioRunInfo& info = field.field->info();
+  const double yaw = resolve_yaw(args, info.layout, field.name);
+  check_inside(mic, "--mic", info.aabb, field_args.allow_outside);
+  check_inside(src, "--src", info.aabb, field_args.allow_outside);
   render::RirRenderOptions o;
   o.seed = args.seed;
-  const io::AudioBuffer rir = render::render_rir(bind(run), model_info(info), mic, src, yaw, o);
+  const io::AudioBuffer rir =
+      render::render_rir(bind(*field.field), model_info(info), mic, src, yaw, o);
   if (summary) {
-    *summary = std::string(data::to_string(info.layout)) + " run, step " +
-               std::to_string(run.step()) + ", mic " + fmt3(mic) + ", src " + fmt3(src) +
+    *summary = std::string(data::to_string(info.layout)) + " field " + field.name + ", step " +
+               std::to_string(field.step) + ", mic " + fmt3(mic) + ", src " + fmt3(src) +
                (info.layout == data::AudioLayout::soundspaces ? ", heading " : ", source yaw ") +
                std::to_string(yaw).substr(0, std::to_string(yaw).find('.') + 2) + " deg";
   }
@@ -283,6 +408,7 @@ io::AudioBuffer render_rir_from_run(const std::string& run_dir, const AudioPoseA
 void add_render_audio_commands(CLI::App& render) {
   add_render_rir(render);
   add_render_loudness(render);
+  add_render_trajectory(render);
 }
 
 }  // namespace neraf::cli

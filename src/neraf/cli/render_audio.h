@@ -1,17 +1,45 @@
 #pragma once
 // The acoustic half of `neraf render` (render rir, render loudness) and the pieces `neraf
-// auralize --run` shares with it: pose options and rendering an RIR from a trained run.
+// auralize --run|--model` shares with it: field and pose options, rendering an RIR from a field.
 #include <CLI/CLI.hpp>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <utility>
 
+#include "neraf/geometry/vec.h"
+#include "neraf/infer/audio_field.h"
 #include "neraf/io/audio_file.h"
 
 namespace neraf::cli {
 
-// Adds `rir` and `loudness` to the `render` command.
+// Adds `rir`, `loudness` and `trajectory` to the `render` command.
 void add_render_audio_commands(CLI::App& render);
+// `render trajectory` (render_trajectory.cpp).
+void add_render_trajectory(CLI::App& render);
+
+// Where the acoustic field comes from: a run folder (LibTorch) or an exported MODEL.nrf (neraf_rt).
+struct FieldArgs {
+  std::string run;
+  std::string model;
+  std::string checkpoint;
+  bool allow_outside = false;
+  CLI::Option* run_opt = nullptr;
+  CLI::Option* model_opt = nullptr;
+};
+
+// --run, --model (exclusive; load_field requires one), --checkpoint (needs --run) and, when
+// `poses` (the command checks poses against the training box), --allow-outside.
+void add_field_options(CLI::App* cmd, FieldArgs& args, bool poses);
+
+struct LoadedField {
+  std::unique_ptr<infer::AudioField> field;
+  std::string name;  // the run folder or the model file, for messages
+  int64_t step = 0;  // the training step of the weights
+};
+
+// Loads what `args` names (usage error when neither or both are given).
+LoadedField load_field(const FieldArgs& args);
 
 struct AudioPoseArgs {
   std::string mic;     // "X,Y,Z"
@@ -21,12 +49,11 @@ struct AudioPoseArgs {
   CLI::Option* yaw_opt = nullptr;
   CLI::Option* src_yaw_opt = nullptr;
   uint64_t seed = 0;
-  std::string checkpoint;
 };
 
-// --mic (when with_mic), --src, --yaw, --src-yaw, --seed, --checkpoint. With required = false
-// (auralize, where --run is optional) they all need `needs` (when given) and the caller checks
-// --mic/--src itself. Returns the --mic and --src options.
+// --mic (when with_mic), --src, --yaw, --src-yaw, --seed. With required = false (auralize, where
+// the field is optional) they all need `needs` (when given) and the caller checks --mic/--src
+// itself. Returns the --mic and --src options.
 std::pair<CLI::Option*, CLI::Option*> add_audio_pose_options(CLI::App* cmd, AudioPoseArgs& args,
                                                              bool with_mic, bool required = true,
                                                              CLI::Option* needs = nullptr);
@@ -34,10 +61,15 @@ std::pair<CLI::Option*, CLI::Option*> add_audio_pose_options(CLI::App* cmd, Audi
 // The text for a command's footer that explains the frame, units and yaw conventions.
 std::string audio_pose_help();
 
-// Loads RUN's acoustic field, checks the pose (usage errors for malformed X,Y,Z, a warning for
-// positions outside the train audio aabb, an error for the orientation flag of the other layout)
-// and renders the RIR with Griffin-Lim. `summary` receives a one-line description.
-io::AudioBuffer render_rir_from_run(const std::string& run_dir, const AudioPoseArgs& args,
-                                    std::string* summary);
+// neraf::Error naming `what` (a flag or a file entry) when p is outside the field's training box,
+// unless allow_outside (then a warning).
+void check_inside(const geometry::Vec3& p, const std::string& what, const data::Aabb& box,
+                  bool allow_outside);
+
+// Checks the pose (usage errors for malformed X,Y,Z, an error for positions outside the training
+// box unless --allow-outside, an error for the orientation flag of the other layout) and renders
+// the RIR with Griffin-Lim. `summary` receives a one-line description.
+io::AudioBuffer render_rir_from_field(const LoadedField& field, const FieldArgs& field_args,
+                                      const AudioPoseArgs& args, std::string* summary);
 
 }  // namespace neraf::cli

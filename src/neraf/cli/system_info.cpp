@@ -33,7 +33,7 @@ std::string loaded_blas_library() {
 
 std::string version_text() {
   const std::string blas = loaded_blas_library();
-  return std::string("neraf 0.1.0\nLibTorch ") + TORCH_VERSION + ", " +
+  return std::string("neraf " NERAF_VERSION "\nLibTorch ") + TORCH_VERSION + ", " +
          std::to_string(torch::get_num_threads()) + " threads\nBLAS " +
          (blas.empty() ? "(none loaded)" : blas);
 }

@@ -1,19 +1,18 @@
-// `neraf train`: trains the radiance field (and, later, the acoustic field) of one scene into a
-// run folder, with periodic atomic checkpoints, --resume, and a checkpoint on Ctrl-C.
+// `neraf train`: trains the radiance and acoustic fields of one scene into a run folder, with
+// periodic atomic checkpoints, --resume, and a checkpoint on Ctrl-C. The flags are resolved into
+// a TrainConfig by infer::resolve_train_config (infer/train_config.h).
 #include <torch/torch.h>
 
 #include <CLI/CLI.hpp>
-#include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <string>
 
 #include "neraf/cli/commands.h"
+#include "neraf/infer/train_config.h"
 #include "neraf/nerf/config.h"
 #include "neraf/train/interrupt.h"
-#include "neraf/train/run.h"
-#include "neraf/train/train_config.h"
+#include "neraf/train/run_training.h"
 #include "neraf/util/error.h"
 #include "neraf/util/log.h"
 
@@ -128,47 +127,22 @@ void register_train(CLI::App& app) {
                  vision_run, audio_start, decay_loss, no_relative]() {
     require(!(args->resume && args->force), "--resume and --force: choose one");
     require(args->resume || data->count() > 0, "--data: required (the dataset folder)");
-    train::TrainConfig cfg = train::train_preset(args->preset);
-    cfg.modality = train::parse_modality(args->modality);
-    const bool paper = args->preset == "paper";
-    if (cfg.modality == train::Modality::joint && paper)
-      cfg.steps = 400001;  // NeRAF's max_num_iterations (audio from step 2001)
-    if (cfg.modality == train::Modality::audio) {
-      // The radiance field is final (the grid is filled once): audio from the first step.
-      cfg.audio.start_step = -1;
-      cfg.audio.schedule.warmup_steps = paper ? 2000 : 100;
-      if (paper)
-        cfg.steps = 398000;
-      else
-        train::set_run_length(cfg, 1500);
-    }
-    // Vision alone on the cpu preset: 2000 steps (~8 minutes on 2 cores for the demo room);
-    // joint runs keep 3000, as the acoustic field starts at step 1000.
-    if (cfg.modality == train::Modality::vision && !paper) train::set_run_length(cfg, 2000);
-    if (steps->count()) train::set_run_length(cfg, args->steps);
-    if (cfg.modality == train::Modality::audio) {  // a short run still gets a (shorter) warm-up
-      auto& schedule = cfg.audio.schedule;
-      schedule.warmup_steps = std::min(schedule.warmup_steps, schedule.max_steps / 2);
-    }
-    cfg.seed = args->seed;
-    if (audio_start->count()) {
-      if (cfg.audio.schedule.warmup_steps == cfg.audio.start_step)  // warm-up ends at the start
-        cfg.audio.schedule.warmup_steps = std::max<int64_t>(0, args->audio_start);
-      cfg.audio.start_step = args->audio_start;
-    }
-    cfg.audio.grid = args->grid;
-    if (decay_loss->count()) cfg.audio.decay_weight = args->decay_loss;
-    cfg.audio.fraction = args->audio_fraction;
-    if (args->no_relative_geometry) cfg.audio.relative_geometry = false;
-    if (vision_run->count())
-      cfg.audio.vision_run =
-          std::filesystem::absolute(args->vision_run).lexically_normal().string();
-    require(cfg.modality == train::Modality::audio || vision_run->count() == 0,
-            "--vision-run: only used with --modality audio");
-    if (threads->count()) cfg.threads = args->threads;
-    if (rays->count()) cfg.rays_per_batch = args->rays;
-    if (precision->count())
-      cfg.model.precision = nerf::parse_precision(args->precision, "--precision");
+    // The flags as given (unset: the preset's value for the modality), resolved in one place.
+    infer::TrainFlags flags;
+    flags.preset = args->preset;
+    flags.modality = infer::parse_modality(args->modality);
+    if (steps->count()) flags.steps = args->steps;
+    flags.seed = args->seed;
+    if (threads->count()) flags.threads = args->threads;
+    if (rays->count()) flags.rays = args->rays;
+    if (precision->count()) flags.precision = nerf::parse_precision(args->precision, "--precision");
+    flags.grid = args->grid;
+    flags.audio_fraction = args->audio_fraction;
+    if (audio_start->count()) flags.audio_start_step = args->audio_start;
+    if (decay_loss->count()) flags.decay_loss = args->decay_loss;
+    flags.no_relative_geometry = args->no_relative_geometry;
+    if (vision_run->count()) flags.vision_run = args->vision_run;
+    const infer::TrainConfig cfg = infer::resolve_train_config(flags);
     if (cfg.model.precision == nerf::Precision::bf16 && !nerf::cpu_supports_bf16())
       warn("--precision bf16: this CPU has no native bf16 instructions; expect slow training");
 
@@ -195,9 +169,9 @@ void register_train(CLI::App& app) {
       std::printf("trained steps %lld..%lld in %.1f s (%.2f steps/s)",
                   static_cast<long long>(s.start_step), static_cast<long long>(s.end_step),
                   s.seconds, s.seconds > 0 ? (s.end_step - s.start_step) / s.seconds : 0.0);
-      if (cfg.modality != train::Modality::audio)
+      if (cfg.modality != infer::Modality::audio)
         std::printf("; %.0f rays/s, train PSNR %.2f dB", s.rays_per_s, s.last_psnr);
-      if (cfg.modality != train::Modality::vision)
+      if (cfg.modality != infer::Modality::vision)
         std::printf("; audio log-mag MSE %.4f", s.last_audio_sl);
       std::printf("; checkpoint %s\n", s.checkpoint.c_str());
     }

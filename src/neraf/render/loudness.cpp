@@ -6,10 +6,10 @@
 #include <cmath>
 #include <cstdio>
 
+#include "neraf/infer/audio_run.h"
+#include "neraf/infer/image_output.h"
 #include "neraf/io/atomic_file.h"
 #include "neraf/render/colormap.h"
-#include "neraf/train/audio_run.h"
-#include "neraf/train/image_output.h"
 #include "neraf/util/error.h"
 #include "neraf/util/progress.h"
 
@@ -81,7 +81,7 @@ torch::Tensor spectrogram_rms(const torch::Tensor& magnitude) {
 
 torch::Tensor log_loudness(const torch::Tensor& log_stft) {
   TORCH_CHECK(log_stft.dim() == 4, "log_loudness: expected [N, C, F, T]");
-  const torch::Tensor mag = train::log_stft_to_magnitude(log_stft.select(1, 0)).to(torch::kFloat64);
+  const torch::Tensor mag = infer::log_stft_to_magnitude(log_stft.select(1, 0)).to(torch::kFloat64);
   return spectrogram_rms(mag).sum(-1).log();  // [N]
 }
 
@@ -136,7 +136,7 @@ void write_loudness_png(const std::string& path, const LoudnessMap& map) {
   const double range = hi > lo ? hi - lo : 1.0;
   // Non-finite cells (silent predictions) draw at the bottom of the scale.
   const torch::Tensor t = ((v - lo) / range).nan_to_num(0.0, 1.0, 0.0).clamp(0.0, 1.0);
-  const torch::Tensor rgb = train::viridis(t);  // [nz, nx, 3]
+  const torch::Tensor rgb = infer::viridis(t);  // [nz, nx, 3]
 
   const int cell = std::max(2, 480 / std::max(nx, nz));
   const int s = 2;  // font scale
@@ -196,10 +196,10 @@ void write_loudness_png(const std::string& path, const LoudnessMap& map) {
   const int bx = left + map_w + bar_gap;
   const torch::Tensor ramp =
       torch::linspace(1.0, 0.0, map_h, torch::kFloat64).view({map_h, 1}).expand({map_h, bar_w});
-  c.paste(train::viridis(ramp), bx, top);
+  c.paste(infer::viridis(ramp), bx, top);
   c.text(hi_s, bx + bar_w + 4, top, s, 0, 0, 0);
   c.text(lo_s, bx + bar_w + 4, top + map_h - 5 * s, s, 0, 0, 0);
-  train::write_png(path, c.pixels());
+  infer::write_png(path, c.pixels());
 }
 
 void write_loudness_csv(const std::string& path, const LoudnessMap& map) {

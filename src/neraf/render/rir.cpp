@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <vector>
 
-#include "neraf/train/audio_run.h"
+#include "neraf/infer/audio_run.h"
 #include "neraf/util/error.h"
 
 namespace neraf::render {
@@ -50,7 +50,7 @@ io::AudioBuffer rir_from_log_stft(const torch::Tensor& log_stft, const dsp::Stft
   io::AudioBuffer out;
   out.sample_rate = sample_rate;
   out.channels =
-      train::griffin_lim_channels(train::log_stft_to_magnitude(log_stft.cpu()), stft, options.seed);
+      infer::griffin_lim_channels(infer::log_stft_to_magnitude(log_stft.cpu()), stft, options.seed);
   return out;
 }
 

@@ -5,9 +5,9 @@
 #include <chrono>
 #include <cmath>
 
+#include "neraf/infer/image_output.h"
 #include "neraf/io/json_file.h"
 #include "neraf/nerf/render_image.h"
-#include "neraf/train/image_output.h"
 #include "neraf/util/error.h"
 
 namespace neraf::render {
@@ -20,7 +20,7 @@ torch::Tensor colorize_depth(const torch::Tensor& depth, double near, double far
     far = torch::quantile(flat, 0.99).item<double>();
     if (!(far > near)) far = near + 1e-6;
   }
-  return train::viridis((d - near) / (far - near));
+  return infer::viridis((d - near) / (far - near));
 }
 
 torch::Tensor normalize_pose(const torch::Tensor& c2w, const torch::Tensor& world_transform,
@@ -65,6 +65,25 @@ torch::Tensor matrix_from_json(const nlohmann::json& j, const std::string& where
 
 }  // namespace
 
+Camera dataset_camera(const torch::Tensor& c2w, const nlohmann::json& manifest) {
+  Camera cam;
+  std::vector<double> wt;
+  for (const auto& row : manifest.at("world_transform"))
+    for (const auto& x : row) wt.push_back(x.get<double>());
+  cam.c2w = normalize_pose(c2w, torch::tensor(wt, torch::kFloat64).view({3, 4}),
+                           manifest.at("world_scale").get<double>());
+  cam.intrinsics = infer::manifest_intrinsics(manifest, -1);
+  return cam;
+}
+
+torch::Tensor listener_camera_to_world(const geometry::Vec3& position, double heading_deg) {
+  // R_y(θ) maps the camera's forward −z to (−sin θ, 0, −cos θ): −z at 0°, −x at 90°.
+  const double th = heading_deg * M_PI / 180.0, c = std::cos(th), s = std::sin(th);
+  return torch::tensor({c, 0.0, s, position.x, 0.0, 1.0, 0.0, position.y, -s, 0.0, c, position.z},
+                       torch::kFloat64)
+      .view({3, 4});
+}
+
 Camera read_camera_file(const std::string& path, const nlohmann::json& manifest) {
   const nlohmann::json j = io::read_json(path);
   nlohmann::json m;
@@ -79,14 +98,7 @@ Camera read_camera_file(const std::string& path, const nlohmann::json& manifest)
     else
       throw Error(path + ": missing \"camera_to_world\" (a 4×4 or 3×4 camera-to-world matrix)");
   }
-  const torch::Tensor c2w = matrix_from_json(m, path + ": camera_to_world");
-  Camera cam;
-  std::vector<double> wt;
-  for (const auto& row : manifest.at("world_transform"))
-    for (const auto& x : row) wt.push_back(x.get<double>());
-  cam.c2w = normalize_pose(c2w, torch::tensor(wt, torch::kFloat64).view({3, 4}),
-                           manifest.at("world_scale").get<double>());
-  cam.intrinsics = train::manifest_intrinsics(manifest, -1);
+  Camera cam = dataset_camera(matrix_from_json(m, path + ": camera_to_world"), manifest);
   if (j.is_object() && j.contains("intrinsics")) {
     nlohmann::json k = j["intrinsics"];
     require(k.is_object(), path + ": \"intrinsics\" must be an object");
@@ -102,12 +114,12 @@ Camera read_camera_file(const std::string& path, const nlohmann::json& manifest)
                              {"cx", cam.intrinsics.cx},       {"cy", cam.intrinsics.cy},
                              {"width", cam.intrinsics.width}, {"height", cam.intrinsics.height}};
     for (auto it = k.begin(); it != k.end(); ++it) merged[it.key()] = it.value();
-    cam.intrinsics = train::intrinsics_from_json(merged, path + ": intrinsics");
+    cam.intrinsics = infer::intrinsics_from_json(merged, path + ": intrinsics");
   }
   return cam;
 }
 
-ViewOutputs render_view(train::LoadedRun& run, const Camera& camera, const std::string& png,
+ViewOutputs render_view(infer::LoadedRun& run, const Camera& camera, const std::string& png,
                         const std::string& depth_png, int64_t chunk) {
   const auto t0 = std::chrono::steady_clock::now();
   const nerf::RenderedImage img =
@@ -115,8 +127,8 @@ ViewOutputs render_view(train::LoadedRun& run, const Camera& camera, const std::
   ViewOutputs out;
   out.rgb = img.rgb.cpu();
   out.depth = img.depth.cpu();
-  train::write_png(png, out.rgb);
-  if (!depth_png.empty()) train::write_png(depth_png, colorize_depth(out.depth));
+  infer::write_png(png, out.rgb);
+  if (!depth_png.empty()) infer::write_png(depth_png, colorize_depth(out.depth));
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

@@ -6,7 +6,8 @@
 #include <string>
 
 #include "neraf/data/image_set.h"
-#include "neraf/train/run.h"
+#include "neraf/geometry/vec.h"
+#include "neraf/infer/run.h"
 
 namespace neraf::render {
 
@@ -28,6 +29,15 @@ struct Camera {
 // (R_n = R·R_c, t_n = scale·(R·t_c + t)). Errors name the file.
 Camera read_camera_file(const std::string& path, const nlohmann::json& manifest);
 
+// A camera at a dataset-frame camera-to-world [3, 4] float64 with the run's first training
+// camera's intrinsics (manifest: the run's RUN/data.json).
+Camera dataset_camera(const torch::Tensor& c2w, const nlohmann::json& manifest);
+
+// The dataset-frame camera-to-world [3, 4] float64 of a listener at `position` (metres, y up)
+// facing the audio heading `heading_deg` (a rotation about +y: 0° looks along −z, 90° along −x,
+// as SoundSpaces' receiver headings), camera looking along its −z with +y up (nerfstudio).
+torch::Tensor listener_camera_to_world(const geometry::Vec3& position, double heading_deg);
+
 // Maps a dataset-frame camera-to-world [3, 4] into the normalised frame.
 torch::Tensor normalize_pose(const torch::Tensor& c2w, const torch::Tensor& world_transform,
                              double world_scale);
@@ -40,7 +50,7 @@ struct ViewOutputs {
 
 // Renders `camera` with the run's model; writes rgb to `png` and, if `depth_png` is not empty,
 // the colour-mapped median depth there (atomic writes).
-ViewOutputs render_view(train::LoadedRun& run, const Camera& camera, const std::string& png,
+ViewOutputs render_view(infer::LoadedRun& run, const Camera& camera, const std::string& png,
                         const std::string& depth_png = "", int64_t chunk = 16384);
 
 }  // namespace neraf::render

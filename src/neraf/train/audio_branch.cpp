@@ -7,47 +7,14 @@
 
 #include "neraf/acoustic/calibration.h"
 #include "neraf/acoustic/losses.h"
+#include "neraf/infer/audio_run.h"
+#include "neraf/infer/checkpoint.h"
 #include "neraf/metrics/room_acoustics.h"
-#include "neraf/train/audio_run.h"
-#include "neraf/train/checkpoint.h"
 #include "neraf/util/error.h"
 
 namespace neraf::train {
 
-acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, int64_t channels,
-                                                   int64_t n_freq, int64_t max_len,
-                                                   const data::Aabb& audio_aabb) {
-  acoustic::AcousticModelOptions o =
-      acoustic::acoustic_preset(config.preset, channels, n_freq, max_len);
-  const AudioConfig& a = config.audio;
-  o.grid_mode = acoustic::parse_grid_mode(a.grid);
-  o.grid.resolution = a.grid_resolution;
-  o.grid.cells_per_update = a.cells_per_update;
-  if (a.nacf_width > 0) o.nacf.trunk.assign(static_cast<size_t>(a.nacf_layers), a.nacf_width);
-  // The NAcF trunk follows --precision, as the radiance field's MLPs.
-  o.nacf.bf16 = config.model.precision == nerf::Precision::bf16;
-  o.nacf.relative_geometry = a.relative_geometry;
-  o.nacf.position_max_freq_exp = a.position_max_freq_exp;
-  const geometry::Vec3& lo = audio_aabb.min;
-  const geometry::Vec3& hi = audio_aabb.max;
-  o.nacf.extent_m = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
-  return o;
-}
-
-std::vector<int64_t> audio_train_subset(const data::RirSet& rirs, double fraction, uint64_t seed) {
-  require(fraction > 0 && fraction <= 1, "--audio-fraction: must be in (0, 1]");
-  std::vector<int64_t> all = rirs.train;
-  if (fraction >= 1.0 || all.empty()) return all;
-  const int64_t n = static_cast<int64_t>(all.size());
-  const int64_t k = std::max<int64_t>(1, std::llround(fraction * static_cast<double>(n)));
-  // Own generator (not the run's stream) so the subset only depends on --seed and the fraction.
-  at::Generator gen = at::make_generator<at::CPUGeneratorImpl>(seed ^ 0x9e3779b97f4a7c15ULL);
-  const torch::Tensor perm = torch::randperm(n, gen, torch::kInt64);
-  std::vector<int64_t> out;
-  for (int64_t i = 0; i < k; ++i) out.push_back(all[static_cast<size_t>(perm[i].item<int64_t>())]);
-  std::sort(out.begin(), out.end());
-  return out;
-}
+using infer::TrainConfig;
 
 AudioBranch::AudioBranch(const TrainConfig& config, const data::RirSet& rirs,
                          nerf::NerfactoModel field, bool frozen_field, torch::Device device)
@@ -60,13 +27,13 @@ AudioBranch::AudioBranch(const TrainConfig& config, const data::RirSet& rirs,
   require(!rirs_.train.empty(),
           "dataset: the audio train split is empty; the acoustic field "
           "needs training RIRs");
-  const acoustic::AcousticModelOptions opts =
-      audio_model_options(config_, rirs_.channels, rirs_.n_freq, rirs_.max_len, rirs_.audio_aabb);
+  const acoustic::AcousticModelOptions opts = infer::audio_model_options(
+      config_, rirs_.channels, rirs_.n_freq, rirs_.max_len, rirs_.audio_aabb);
   model_ = acoustic::AcousticModel(opts);
   model_->to(device_);
   grid_ = acoustic::GridSampler(opts.grid);
   grid_->to(device_);
-  train_rirs_ = audio_train_subset(rirs_, config_.audio.fraction, config_.seed);
+  train_rirs_ = infer::audio_train_subset(rirs_, config_.audio.fraction, config_.seed);
   if (frozen_ && opts.grid_mode == acoustic::GridMode::kSampled) {
     // The paper's separate training: the field is final, so the whole grid is filled once.
     field_->eval();
@@ -225,9 +192,9 @@ torch::Tensor AudioBranch::energy_calibration() {
   for (size_t r = 0; r < preds.size(); ++r) {
     const auto& [i, pred] = preds[r];
     const torch::Tensor gt = rirs_.waveform(i).contiguous();  // [C, L]
-    const auto wave =
-        griffin_lim_channels(log_stft_to_magnitude(acoustic::apply_calibration(pred, gain)),
-                             rirs_.stft, config_.seed + r, gt.size(1));
+    const auto wave = infer::griffin_lim_channels(
+        infer::log_stft_to_magnitude(acoustic::apply_calibration(pred, gain)), rirs_.stft,
+        config_.seed + r, gt.size(1));
     for (int64_t c = 0; c < C; ++c) {
       const float* g = gt[c].data_ptr<float>();
       const double d = metrics::measure_c50(std::vector<float>(g, g + gt.size(1)), fs) -
@@ -255,7 +222,7 @@ void AudioBranch::save(torch::serialize::OutputArchive& archive) {
   archive.write("grid", g);
   archive.write("perm", perm_.defined() ? perm_ : torch::empty({0}, torch::kInt64));
   archive.write("cursor", torch::tensor(cursor_, torch::kInt64));
-  archive.write("manifest", c10::IValue(make_audio_manifest(rirs_).dump()));
+  archive.write("manifest", c10::IValue(infer::make_audio_manifest(rirs_).dump()));
   archive.write("train_rirs", torch::tensor(train_rirs_, torch::kInt64));
   archive.write("calibration", energy_calibration());
 }
@@ -264,13 +231,13 @@ void AudioBranch::load(torch::serialize::InputArchive& archive, const std::strin
   c10::IValue manifest;
   require(archive.try_read("manifest", manifest) && manifest.isString(),
           where + ": checkpoint has no audio data manifest; it was not written by neraf train");
-  check_audio_manifest(nlohmann::json::parse(manifest.toStringRef()), rirs_, where);
+  infer::check_audio_manifest(nlohmann::json::parse(manifest.toStringRef()), rirs_, where);
   torch::serialize::InputArchive m, g;
   archive.read("model", m);
-  load_module(*model_, m, where);
+  infer::load_module(*model_, m, where);
   model_->to(device_);
   archive.read("grid", g);
-  load_module(*grid_, g, where);
+  infer::load_module(*grid_, g, where);
   grid_->to(device_);
   torch::Tensor perm, cursor, subset;
   archive.read("perm", perm);

@@ -16,7 +16,8 @@
 // filled once from it (no per-step updates).
 //
 // INFERENCE (render rir / loudness / auralize --run) does not need this class: use
-// train/audio_run.h (load_audio_run + AudioRun::predict_log_stft).
+// infer/audio_run.h (load_audio_run + AudioRun::predict_log_stft); the model options and the
+// few-shot subset a run trains on are there too (audio_model_options, audio_train_subset).
 #include <torch/torch.h>
 
 #include <cstdint>
@@ -27,28 +28,17 @@
 #include "neraf/acoustic/acoustic_model.h"
 #include "neraf/acoustic/grid_sampler.h"
 #include "neraf/data/rir_set.h"
+#include "neraf/infer/train_config.h"
 #include "neraf/train/trainer.h"
 
 namespace neraf::train {
-
-// The acoustic model options of a run: the preset's (`config.preset`) sized to the data, with the
-// AudioConfig overrides (grid mode, resolution, cells per update, NAcF width, relative geometry
-// in the metres of `audio_aabb`).
-acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, int64_t channels,
-                                                   int64_t n_freq, int64_t max_len,
-                                                   const data::Aabb& audio_aabb);
-
-// The seeded subset of `rirs.train` used for training (--audio-fraction): all of it for
-// fraction 1, else round(fraction·N) (at least 1) indices drawn without replacement with `seed`,
-// in ascending order.
-std::vector<int64_t> audio_train_subset(const data::RirSet& rirs, double fraction, uint64_t seed);
 
 class AudioBranch : public Branch {
  public:
   // `field`: the radiance field that fills the grid (the vision branch's model in joint mode, or a
   // frozen model from a vision run in audio mode — then `frozen_field` = true and the grid is
   // filled completely here). `rirs` must have features and outlive the branch.
-  AudioBranch(const TrainConfig& config, const data::RirSet& rirs, nerf::NerfactoModel field,
+  AudioBranch(const infer::TrainConfig& config, const data::RirSet& rirs, nerf::NerfactoModel field,
               bool frozen_field, torch::Device device);
 
   std::string name() const override { return "audio"; }
@@ -76,7 +66,7 @@ class AudioBranch : public Branch {
   // energy-decay loss (D = 0 when it is off).
   std::pair<torch::Tensor, torch::Tensor> sample_slices(at::Generator& gen, int64_t D);
 
-  TrainConfig config_;
+  infer::TrainConfig config_;
   const data::RirSet& rirs_;
   nerf::NerfactoModel field_;
   bool frozen_;

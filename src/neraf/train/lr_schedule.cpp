@@ -5,7 +5,7 @@
 
 namespace neraf::train {
 
-double learning_rate(const ScheduleConfig& s, int64_t step) {
+double learning_rate(const infer::ScheduleConfig& s, int64_t step) {
   if (step < s.warmup_steps) {
     const double x = static_cast<double>(step) / static_cast<double>(s.warmup_steps);
     const double r = s.warmup_ramp == "sine" ? std::sin(0.5 * M_PI * x) : x;

@@ -5,58 +5,19 @@
 #include <cmath>
 #include <mutex>
 
+#include "neraf/infer/checkpoint.h"
+#include "neraf/infer/run.h"
 #include "neraf/nerf/rays.h"
 #include "neraf/nerf/samplers.h"
 #include "neraf/train/audio_branch.h"
-#include "neraf/train/checkpoint.h"
 #include "neraf/train/lr_schedule.h"
-#include "neraf/train/run.h"
 #include "neraf/util/error.h"
 
 namespace neraf::train {
 
-namespace {
-constexpr const char* kFormat = "neraf-checkpoint-1";
-
-// Settings that may differ between a checkpoint and the run loading it: run length and
-// bookkeeping, and the matmul precision (the master weights are fp32 either way). A schedule
-// whose decay is tied to the run length (max_steps == steps) follows --steps on resume, so it
-// compares as "the run length", not as a number.
-nlohmann::json comparable(nlohmann::json j) {
-  const nlohmann::json steps = j.value("steps", nlohmann::json());
-  for (nlohmann::json* s : {&j["fields"], &j["proposal_networks"], &j["audio"]["schedule"]})
-    if (s->is_object() && s->value("max_steps", nlohmann::json()) == steps)
-      (*s)["max_steps"] = "steps";
-  for (const char* k : {"steps", "threads", "save_every", "eval_rays_per_chunk"}) j.erase(k);
-  if (j.contains("model")) j["model"].erase("precision");
-  // Vision runs ignore the acoustic settings (and checkpoints older than them have none).
-  if (j.value("modality", "") == "vision") j.erase("audio");
-  return j;
-}
-}  // namespace
-
-std::string first_difference(const nlohmann::json& a, const nlohmann::json& b,
-                             const std::string& prefix) {
-  if (a.is_object() && b.is_object()) {
-    for (auto it = a.begin(); it != a.end(); ++it) {
-      const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
-      if (!b.contains(it.key())) return key;
-      const std::string d = first_difference(it.value(), b[it.key()], key);
-      if (!d.empty()) return d;
-    }
-    for (auto it = b.begin(); it != b.end(); ++it)
-      if (!a.contains(it.key())) return prefix.empty() ? it.key() : prefix + "." + it.key();
-    return "";
-  }
-  if (a.is_array() && b.is_array() && a.size() == b.size()) {
-    for (size_t i = 0; i < a.size(); ++i) {
-      const std::string d = first_difference(a[i], b[i], prefix + "[" + std::to_string(i) + "]");
-      if (!d.empty()) return d;
-    }
-    return "";
-  }
-  return a == b ? "" : (prefix.empty() ? "(root)" : prefix);
-}
+using infer::LoadedRun;
+using infer::Modality;
+using infer::TrainConfig;
 
 // ---------------------------------------------------------------------------------------------
 // VisionBranch
@@ -134,7 +95,7 @@ void VisionBranch::save(torch::serialize::OutputArchive& archive) {
 void VisionBranch::load(torch::serialize::InputArchive& archive, const std::string& where) {
   torch::serialize::InputArchive model_archive;
   archive.read("model", model_archive);
-  load_module(*model_, model_archive, where);
+  infer::load_module(*model_, model_archive, where);
   model_->to(device_);
   torch::Tensor s;
   archive.read("steps_since_update", s);
@@ -220,7 +181,7 @@ StepResult Trainer::step() {
 void Trainer::save_checkpoint(const std::string& path) {
   if (groups_.empty()) build_optimizers();
   torch::serialize::OutputArchive a;
-  a.write("format", c10::IValue(std::string(kFormat)));
+  a.write("format", c10::IValue(std::string(infer::kCheckpointFormat)));
   a.write("config", c10::IValue(to_json(config_).dump()));
   a.write("step", torch::tensor(step_, torch::kInt64));
   {
@@ -237,14 +198,14 @@ void Trainer::save_checkpoint(const std::string& path) {
     g.optimizer->save(sub);
     a.write("optim_" + g.name, sub);
   }
-  save_archive(a, path);
+  infer::save_archive(a, path);
 }
 
 void Trainer::load_checkpoint(const std::string& path) {
   if (groups_.empty()) build_optimizers();
   torch::serialize::InputArchive a;
-  load_archive(a, path);
-  check_checkpoint_header(a, config_, path);
+  infer::load_archive(a, path);
+  infer::check_checkpoint_header(a, config_, path);
   try {
     torch::Tensor step, rng;
     a.read("step", step);
@@ -270,36 +231,6 @@ void Trainer::load_checkpoint(const std::string& path) {
   }
 }
 
-nlohmann::json check_checkpoint_header(torch::serialize::InputArchive& a, const TrainConfig& config,
-                                       const std::string& path) {
-  nlohmann::json stored;
-  try {
-    c10::IValue fmt;
-    require(
-        a.try_read("format", fmt) && fmt.isString() && fmt.toStringRef() == kFormat,
-        path + ": not a neraf training checkpoint; point --run at a folder made by neraf train");
-    c10::IValue cfg;
-    a.read("config", cfg);
-    stored = nlohmann::json::parse(cfg.toStringRef());
-  } catch (const c10::Error&) {
-    throw Error(path + ": checkpoint header is unreadable (corrupted file); delete it");
-  } catch (const nlohmann::json::exception&) {
-    throw Error(path + ": checkpoint config is corrupted; delete the file");
-  }
-  const nlohmann::json mine = to_json(config);
-  if (stored.value("preset", "") != config.preset)
-    throw Error(path + ": checkpoint was trained with --preset " + stored.value("preset", "?") +
-                ", this run uses --preset " + config.preset +
-                "; use the same preset or a new --out folder");
-  // Keys newer than the checkpoint take their preset defaults, as when config.json is read.
-  const nlohmann::json stored_full = to_json(train_config_from_json(stored, path));
-  const std::string diff = first_difference(comparable(stored_full), comparable(mine));
-  if (!diff.empty())
-    throw Error(path + ": checkpoint was trained with a different config (" + diff +
-                " differs); use the run's own config.json or a new --out folder");
-  return stored;
-}
-
 std::unique_ptr<Trainer> make_trainer(const TrainConfig& config, const data::ImageSet* images,
                                       torch::Device device, const data::RirSet* rirs) {
   validate(config, "config");
@@ -312,7 +243,7 @@ std::unique_ptr<Trainer> make_trainer(const TrainConfig& config, const data::Ima
     // The paper's separate training: the acoustic field on the frozen grid of a vision run.
     require(!config.audio.vision_run.empty(),
             "--vision-run: required with --modality audio (a finished vision or joint run)");
-    LoadedRun vision = load_run(config.audio.vision_run, device);
+    LoadedRun vision = infer::load_run(config.audio.vision_run, device);
     for (auto& p : vision.model->parameters()) p.set_requires_grad(false);
     trainer->add_branch(
         std::make_unique<AudioBranch>(config, *rirs, vision.model, /*frozen_field=*/true, device));

@@ -12,7 +12,7 @@
 //      `add_branch` it after the vision branch. Branches run in insertion order each step, so the
 //      audio branch sees the vision branch's step already taken (grid updates can go in
 //      `Branch::losses` of the audio branch).
-//   3. Put its config struct in TrainConfig (train_config.h) and its eval in evaluation.h.
+//   3. Put its config struct in TrainConfig (infer/train_config.h) and its eval in eval/.
 // Everything else (optimizers, schedules, checkpoints, resume, SIGINT, progress) is generic.
 #include <torch/torch.h>
 
@@ -24,8 +24,8 @@
 
 #include "neraf/data/image_set.h"
 #include "neraf/data/rir_set.h"
+#include "neraf/infer/train_config.h"
 #include "neraf/nerf/nerfacto_model.h"
-#include "neraf/train/train_config.h"
 
 namespace neraf::train {
 
@@ -37,7 +37,7 @@ using LossDict = nerf::LossDict;
 struct ParamGroup {
   std::string name;
   std::vector<torch::Tensor> params;
-  ScheduleConfig schedule;
+  infer::ScheduleConfig schedule;
 };
 
 // What a branch sees during a step.
@@ -65,7 +65,8 @@ class Branch {
 // Nerfacto on posed images: random pixels over all training images each step.
 class VisionBranch : public Branch {
  public:
-  VisionBranch(const TrainConfig& config, const data::ImageSplit& train, torch::Device device);
+  VisionBranch(const infer::TrainConfig& config, const data::ImageSplit& train,
+               torch::Device device);
 
   std::string name() const override { return "vision"; }
   std::vector<ParamGroup> param_groups() override;
@@ -80,7 +81,7 @@ class VisionBranch : public Branch {
   int64_t steps_since_update() const { return steps_since_update_; }
 
  private:
-  TrainConfig config_;
+  infer::TrainConfig config_;
   torch::Device device_;
   nerf::NerfactoModel model_{nullptr};
   torch::Tensor pixels_;  // [N·H·W, 3] uint8 on device
@@ -100,7 +101,7 @@ struct StepResult {
 
 class Trainer {
  public:
-  Trainer(TrainConfig config, torch::Device device);
+  Trainer(infer::TrainConfig config, torch::Device device);
 
   // Branches must be added before the first step and before load_checkpoint.
   void add_branch(std::unique_ptr<Branch> branch);
@@ -116,7 +117,7 @@ class Trainer {
   void save_checkpoint(const std::string& path);
   void load_checkpoint(const std::string& path);
 
-  const TrainConfig& config() const { return config_; }
+  const infer::TrainConfig& config() const { return config_; }
   void set_total_steps(int64_t steps) { config_.steps = steps; }
   VisionBranch* vision();  // nullptr when the run has no vision branch
   Branch* branch(const std::string& name);
@@ -129,12 +130,12 @@ class Trainer {
 
   struct Group {
     std::string name;
-    ScheduleConfig schedule;
+    infer::ScheduleConfig schedule;
     std::vector<torch::Tensor> params;
     std::unique_ptr<torch::optim::Adam> optimizer;
   };
 
-  TrainConfig config_;
+  infer::TrainConfig config_;
   torch::Device device_;
   std::vector<std::unique_ptr<Branch>> branches_;
   std::vector<Group> groups_;
@@ -145,17 +146,8 @@ class Trainer {
 // The trainer for `config.modality` with its branches. Vision/joint need `images`; audio/joint
 // need `rirs` (with features; must outlive the trainer). Modality audio loads the frozen
 // radiance field from config.audio.vision_run (see audio_branch.h).
-std::unique_ptr<Trainer> make_trainer(const TrainConfig& config, const data::ImageSet* images,
-                                      torch::Device device, const data::RirSet* rirs = nullptr);
-
-// Reads a checkpoint's header ("format" and the resolved config) and checks that it describes
-// the same model as `config` (preset, modality, model settings except precision); neraf::Error
-// naming `path` and the first differing setting otherwise. Returns the stored config JSON.
-nlohmann::json check_checkpoint_header(torch::serialize::InputArchive& archive,
-                                       const TrainConfig& config, const std::string& path);
-
-// The one key of `a` and `b` (JSON objects) that differs first, as a dotted path ("" if equal).
-std::string first_difference(const nlohmann::json& a, const nlohmann::json& b,
-                             const std::string& prefix = "");
+std::unique_ptr<Trainer> make_trainer(const infer::TrainConfig& config,
+                                      const data::ImageSet* images, torch::Device device,
+                                      const data::RirSet* rirs = nullptr);
 
 }  // namespace neraf::train

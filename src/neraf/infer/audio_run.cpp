@@ -1,0 +1,241 @@
+#include "neraf/infer/audio_run.h"
+
+#include <ATen/CPUGeneratorImpl.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "neraf/acoustic/calibration.h"
+#include "neraf/dsp/griffin_lim.h"
+#include "neraf/infer/checkpoint.h"
+#include "neraf/io/json_file.h"
+#include "neraf/util/error.h"
+
+namespace fs = std::filesystem;
+
+namespace neraf::infer {
+
+namespace {
+
+// FNV-1a over the RIR ids, split membership, headings and poses (µm), so any change of the
+// dataset's content that the acoustic field depends on changes the hash.
+std::string dataset_hash(const data::RirSet& r) {
+  uint64_t h = 1469598103934665603ULL;
+  auto mix = [&](const std::string& s) {
+    for (unsigned char c : s) {
+      h ^= c;
+      h *= 1099511628211ULL;
+    }
+    h ^= 0xff;
+    h *= 1099511628211ULL;
+  };
+  char buf[160];
+  for (const data::Rir& x : r.rirs) {
+    std::snprintf(buf, sizeof buf, "%d %.6f %.6f %.6f %.6f %.6f %.6f", x.heading_deg, x.mic.x,
+                  x.mic.y, x.mic.z, x.source.x, x.source.y, x.source.z);
+    mix(x.id);
+    mix(buf);
+  }
+  for (int64_t i : r.train) mix(std::to_string(i));
+  char out[17];
+  std::snprintf(out, sizeof out, "%016llx", static_cast<unsigned long long>(h));
+  return out;
+}
+
+nlohmann::json vec_json(const geometry::Vec3& v) { return {v.x, v.y, v.z}; }
+
+geometry::Vec3 vec_from(const nlohmann::json& j) {
+  return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
+}
+
+}  // namespace
+
+nlohmann::json make_audio_manifest(const data::RirSet& r) {
+  return {{"layout", data::to_string(r.layout)},
+          {"num_rirs", r.size()},
+          {"num_train", static_cast<int64_t>(r.train.size())},
+          {"num_test", static_cast<int64_t>(r.test.size())},
+          {"hash", dataset_hash(r)},
+          {"sample_rate", r.sample_rate},
+          {"channels", r.channels},
+          {"n_fft", r.stft.n_fft},
+          {"win_length", r.stft.win_length},
+          {"hop_length", r.stft.hop_length},
+          {"n_freq", r.n_freq},
+          {"max_len", r.max_len},
+          {"waveform_length", r.waveform_length},
+          {"aabb_min", vec_json(r.audio_aabb.min)},
+          {"aabb_max", vec_json(r.audio_aabb.max)}};
+}
+
+AudioRunInfo audio_info_from_manifest(const nlohmann::json& a, const std::string& where) {
+  try {
+    AudioRunInfo info;
+    const std::string layout = a.at("layout").get<std::string>();
+    require(layout == "soundspaces" || layout == "raf", where + ": unknown audio layout");
+    info.layout = layout == "raf" ? data::AudioLayout::raf : data::AudioLayout::soundspaces;
+    info.sample_rate = a.at("sample_rate").get<int>();
+    info.channels = a.at("channels").get<int>();
+    info.stft.n_fft = a.at("n_fft").get<int>();
+    info.stft.win_length = a.at("win_length").get<int>();
+    info.stft.hop_length = a.at("hop_length").get<int>();
+    info.stft.center = true;
+    info.n_freq = a.at("n_freq").get<int64_t>();
+    info.max_len = a.at("max_len").get<int64_t>();
+    info.waveform_length = a.at("waveform_length").get<int64_t>();
+    info.aabb.min = vec_from(a.at("aabb_min"));
+    info.aabb.max = vec_from(a.at("aabb_max"));
+    return info;
+  } catch (const nlohmann::json::exception&) {
+    throw Error(where + ": the audio manifest is incomplete; re-run neraf train");
+  }
+}
+
+void check_audio_manifest(const nlohmann::json& manifest, const data::RirSet& rirs,
+                          const std::string& where) {
+  const nlohmann::json now = make_audio_manifest(rirs);
+  for (const char* key :
+       {"layout", "num_rirs", "num_train", "hash", "channels", "n_freq", "max_len"})
+    require(manifest.value(key, nlohmann::json()) == now[key],
+            where + ": was trained on another RIR dataset (" + key +
+                " differs: " + manifest.value(key, nlohmann::json()).dump() + " vs " +
+                now[key].dump() + "); use the original --data or a new --out folder");
+}
+
+void check_same_room_format(const nlohmann::json& manifest, const data::RirSet& rirs,
+                            const std::string& where) {
+  const nlohmann::json now = make_audio_manifest(rirs);
+  for (const char* key : {"layout", "sample_rate", "channels", "n_fft", "win_length", "hop_length",
+                          "n_freq", "max_len", "waveform_length"})
+    require(manifest.value(key, nlohmann::json()) == now[key],
+            where + ": its " + key + " (" + now[key].dump() + ") differs from the run's (" +
+                manifest.value(key, nlohmann::json()).dump() +
+                "); synthesise or convert it in the run's format");
+}
+
+acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, int64_t channels,
+                                                   int64_t n_freq, int64_t max_len,
+                                                   const data::Aabb& audio_aabb) {
+  acoustic::AcousticModelOptions o =
+      acoustic::acoustic_preset(config.preset, channels, n_freq, max_len);
+  const AudioConfig& a = config.audio;
+  o.grid_mode = acoustic::parse_grid_mode(a.grid);
+  o.grid.resolution = a.grid_resolution;
+  o.grid.cells_per_update = a.cells_per_update;
+  if (a.nacf_width > 0) o.nacf.trunk.assign(static_cast<size_t>(a.nacf_layers), a.nacf_width);
+  // The NAcF trunk follows --precision, as the radiance field's MLPs.
+  o.nacf.bf16 = config.model.precision == nerf::Precision::bf16;
+  o.nacf.relative_geometry = a.relative_geometry;
+  o.nacf.position_max_freq_exp = a.position_max_freq_exp;
+  const geometry::Vec3& lo = audio_aabb.min;
+  const geometry::Vec3& hi = audio_aabb.max;
+  o.nacf.extent_m = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
+  return o;
+}
+
+std::vector<int64_t> audio_train_subset(const data::RirSet& rirs, double fraction, uint64_t seed) {
+  require(fraction > 0 && fraction <= 1, "--audio-fraction: must be in (0, 1]");
+  std::vector<int64_t> all = rirs.train;
+  if (fraction >= 1.0 || all.empty()) return all;
+  const int64_t n = static_cast<int64_t>(all.size());
+  const int64_t k = std::max<int64_t>(1, std::llround(fraction * static_cast<double>(n)));
+  // Own generator (not the run's stream) so the subset only depends on --seed and the fraction.
+  at::Generator gen = at::make_generator<at::CPUGeneratorImpl>(seed ^ 0x9e3779b97f4a7c15ULL);
+  const torch::Tensor perm = torch::randperm(n, gen, torch::kInt64);
+  std::vector<int64_t> out;
+  for (int64_t i = 0; i < k; ++i) out.push_back(all[static_cast<size_t>(perm[i].item<int64_t>())]);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+torch::Tensor AudioRun::predict_normalised(const torch::Tensor& mic_norm,
+                                           const torch::Tensor& src_norm,
+                                           const torch::Tensor& rot) const {
+  const torch::Tensor raw = model_->render_stft_with_feature(feature_, mic_norm, src_norm, rot);
+  return calibration_.defined() ? acoustic::apply_calibration(raw, calibration_)
+                                : raw;  // [C, F, T]
+}
+
+torch::Tensor AudioRun::predict_log_stft_batch(const torch::Tensor& mic, const torch::Tensor& src,
+                                               const torch::Tensor& yaw_deg) const {
+  const torch::Tensor mn = data::normalize_position(mic.to(torch::kFloat64), info_.aabb);
+  const torch::Tensor sn = data::normalize_position(src.to(torch::kFloat64), info_.aabb);
+  const torch::Tensor th = yaw_deg.to(torch::kFloat64) * (M_PI / 180.0);
+  const torch::Tensor rot = torch::stack(
+      {(torch::cos(th) + 1) / 2, torch::full_like(th, 0.5), (torch::sin(th) + 1) / 2}, 1);
+  std::vector<torch::Tensor> out;
+  for (int64_t i = 0; i < mn.size(0); ++i) out.push_back(predict_normalised(mn[i], sn[i], rot[i]));
+  return torch::stack(out);  // [N, C, F, T]
+}
+
+AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
+                        const std::string& checkpoint) {
+  std::error_code ec;
+  const std::string config_path = (fs::path(run_dir) / "config.json").string();
+  const std::string manifest_path = (fs::path(run_dir) / "data.json").string();
+  require(fs::is_directory(run_dir, ec), run_dir + ": no such run folder; check --run");
+  require(fs::is_regular_file(config_path, ec),
+          run_dir +
+              ": not a training run (no config.json); point --run at a neraf train --out "
+              "folder");
+  AudioRun out;
+  out.run_.run_dir = run_dir;
+  out.run_.config = train_config_from_json(io::read_json(config_path), config_path);
+  require(out.run_.config.modality != Modality::vision,
+          run_dir +
+              ": this run has no acoustic field (trained with --modality vision); train "
+              "with --modality joint or audio");
+  out.run_.manifest = io::read_json(manifest_path);
+  require(out.run_.manifest.contains("audio"),
+          manifest_path + ": no audio manifest; re-run neraf train with --modality joint");
+  out.info_ = audio_info_from_manifest(out.run_.manifest["audio"], manifest_path);
+  if (checkpoint.empty()) {
+    const auto latest = latest_checkpoint(run_dir);
+    require(latest.has_value(), run_dir + ": no checkpoint yet; train first");
+    out.run_.checkpoint = *latest;
+  } else {
+    out.run_.checkpoint = checkpoint;
+  }
+  const AudioRunInfo& info = out.info_;
+  acoustic::AcousticModelOptions opts =
+      audio_model_options(out.run_.config, info.channels, info.n_freq, info.max_len, info.aabb);
+  // Queries run in fp32 whatever trained the run (bf16 training keeps fp32 master weights): the
+  // numbers of eval and render do not depend on the machine, and match an fp32 export.
+  opts.nacf.bf16 = false;
+  out.model_ = acoustic::AcousticModel(opts);
+  acoustic::GridSampler grid(opts.grid);
+  torch::serialize::InputArchive a;
+  load_archive(a, out.run_.checkpoint);
+  check_checkpoint_header(a, out.run_.config, out.run_.checkpoint);
+  try {
+    torch::serialize::InputArchive branch, m, g;
+    a.read("branch_audio", branch);
+    branch.read("model", m);
+    load_module(*out.model_, m, out.run_.checkpoint);
+    branch.read("grid", g);
+    load_module(*grid, g, out.run_.checkpoint);
+    c10::IValue calibration;  // absent in checkpoints written before it existed
+    if (out.run_.config.audio.energy_calibration && branch.try_read("calibration", calibration))
+      out.calibration_ = calibration.toTensor().to(device);
+    torch::Tensor step;
+    a.read("step", step);
+    out.run_.step = step.item<int64_t>();
+  } catch (const c10::Error& e) {
+    std::string what = e.what_without_backtrace();
+    throw Error(out.run_.checkpoint + ": checkpoint does not match the run's config (" +
+                what.substr(0, what.find('\n')) + "); it belongs to another run");
+  }
+  out.model_->to(device);
+  grid->to(device);
+  out.model_->eval();
+  {
+    // The scene feature is computed once: eval-mode ResNet3D on the grid saved at that step.
+    torch::NoGradGuard no_grad;
+    out.feature_ = out.model_->scene_feature(grid->grid().detach());
+  }
+  return out;
+}
+
+}  // namespace neraf::infer

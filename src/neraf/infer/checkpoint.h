@@ -1,0 +1,48 @@
+#pragma once
+// Checkpoint files: LibTorch archives written atomically (temporary file + rename), named
+// RUN/checkpoints/step-XXXXXXXXX.pt (9-digit step, so names sort by step). The trainer writes
+// them (train/trainer.h); reading them (the header check, modules) is here, for loading a run.
+#include <torch/nn/module.h>
+#include <torch/serialize/input-archive.h>
+#include <torch/serialize/output-archive.h>
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "neraf/infer/train_config.h"
+
+namespace neraf::infer {
+
+// The archive's "format" entry (archive layout: train/trainer.h, Trainer::save_checkpoint).
+constexpr const char* kCheckpointFormat = "neraf-checkpoint-1";
+
+std::string checkpoint_dir(const std::string& run_dir);                 // RUN/checkpoints
+std::string checkpoint_path(const std::string& run_dir, int64_t step);  // .../step-000001000.pt
+// The highest-step checkpoint in RUN/checkpoints, if any.
+std::optional<std::string> latest_checkpoint(const std::string& run_dir);
+// The step encoded in a checkpoint file name (−1 when the name does not follow the pattern).
+int64_t checkpoint_step_from_name(const std::string& path);
+
+// Writes `archive` to `path` atomically (the parent folder is created).
+void save_archive(torch::serialize::OutputArchive& archive, const std::string& path);
+// Reads an archive; a missing, truncated or corrupted file is a neraf::Error naming it.
+void load_archive(torch::serialize::InputArchive& archive, const std::string& path);
+
+// module.load(archive), plus what LibTorch does not check: every parameter and buffer keeps its
+// shape (LibTorch would silently resize them). neraf::Error naming `where` on any mismatch.
+void load_module(torch::nn::Module& module, torch::serialize::InputArchive& archive,
+                 const std::string& where);
+
+// Reads a checkpoint's header ("format" and the resolved config) and checks that it describes
+// the same model as `config` (preset, modality, model settings except precision); neraf::Error
+// naming `path` and the first differing setting otherwise. Returns the stored config JSON.
+nlohmann::json check_checkpoint_header(torch::serialize::InputArchive& archive,
+                                       const TrainConfig& config, const std::string& path);
+
+// The one key of `a` and `b` (JSON objects) that differs first, as a dotted path ("" if equal).
+std::string first_difference(const nlohmann::json& a, const nlohmann::json& b,
+                             const std::string& prefix = "");
+
+}  // namespace neraf::infer

@@ -1,0 +1,172 @@
+#include "neraf/infer/run.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include "neraf/infer/checkpoint.h"
+#include "neraf/io/json_file.h"
+#include "neraf/util/error.h"
+
+namespace fs = std::filesystem;
+
+namespace neraf::infer {
+
+namespace {
+constexpr const char* kManifestFormat = "neraf-run-data-1";
+}  // namespace
+
+nlohmann::json intrinsics_json(const data::Intrinsics& k) {
+  return {{"fx", k.fx},       {"fy", k.fy},         {"cx", k.cx}, {"cy", k.cy},
+          {"width", k.width}, {"height", k.height}, {"k1", k.k1}, {"k2", k.k2},
+          {"k3", k.k3},       {"p1", k.p1},         {"p2", k.p2}};
+}
+
+data::Intrinsics intrinsics_from_json(const nlohmann::json& j, const std::string& where) {
+  require(j.is_object(), where + ": expected an object with fx, fy, cx, cy, width, height");
+  data::Intrinsics k;
+  auto num = [&](const char* key, double fallback, bool required) {
+    if (!j.contains(key)) {
+      require(!required, where + "." + key + ": missing");
+      return fallback;
+    }
+    require(j[key].is_number(), where + "." + key + ": expected a number");
+    return j[key].get<double>();
+  };
+  k.fx = num("fx", 0, true);
+  k.fy = num("fy", 0, true);
+  k.cx = num("cx", 0, true);
+  k.cy = num("cy", 0, true);
+  k.width = static_cast<int>(num("width", 0, true));
+  k.height = static_cast<int>(num("height", 0, true));
+  k.k1 = num("k1", 0, false);
+  k.k2 = num("k2", 0, false);
+  k.k3 = num("k3", 0, false);
+  k.p1 = num("p1", 0, false);
+  k.p2 = num("p2", 0, false);
+  require(k.fx > 0 && k.fy > 0 && std::isfinite(k.fx) && std::isfinite(k.fy),
+          where + ": fx and fy must be positive");
+  require(k.width > 0 && k.height > 0 && k.width <= 16384 && k.height <= 16384,
+          where + ": width and height must be in 1..16384");
+  return k;
+}
+
+namespace {
+
+nlohmann::json matrix_json(const torch::Tensor& m) {  // [3, 4]
+  const torch::Tensor c = m.to(torch::kFloat64).contiguous();
+  nlohmann::json rows = nlohmann::json::array();
+  for (int64_t r = 0; r < c.size(0); ++r) {
+    nlohmann::json row = nlohmann::json::array();
+    for (int64_t k = 0; k < c.size(1); ++k) row.push_back(c[r][k].item<double>());
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::string run_file(const std::string& run_dir, const char* name) {
+  return (fs::path(run_dir) / name).string();
+}
+
+}  // namespace
+
+nlohmann::json make_data_manifest(const data::ImageSet& images, const std::string& data_dir) {
+  std::error_code ec;
+  const std::string abs = fs::absolute(data_dir, ec).lexically_normal().string();
+  nlohmann::json eval_poses = nlohmann::json::array(), eval_intr = nlohmann::json::array();
+  for (int64_t i = 0; i < images.eval.size(); ++i) {
+    eval_poses.push_back(matrix_json(images.eval.camera_to_world[i]));
+    eval_intr.push_back(intrinsics_json(images.eval.intrinsics[static_cast<size_t>(i)]));
+  }
+  const data::Intrinsics& k0 = images.train.intrinsics.at(0);
+  // Image paths relative to the dataset folder, so the same data read from another working
+  // directory (or by absolute path) matches.
+  const fs::path root = fs::path(images.source).parent_path();
+  auto relative = [&root](const std::vector<std::string>& files) {
+    std::vector<std::string> out;
+    for (const auto& f : files) out.push_back(fs::path(f).lexically_relative(root).string());
+    return out;
+  };
+  return {{"format", kManifestFormat},
+          {"data", abs},
+          {"source", images.source},
+          {"eval_mode", images.eval_mode},
+          {"num_train", images.train.size()},
+          {"num_eval", images.eval.size()},
+          {"height", k0.height},
+          {"width", k0.width},
+          {"train_files", relative(images.train.files)},
+          {"eval_files", relative(images.eval.files)},
+          {"world_transform", matrix_json(images.world_transform)},
+          {"world_scale", images.world_scale},
+          {"default_intrinsics", intrinsics_json(k0)},
+          {"eval_intrinsics", eval_intr},
+          {"eval_camera_to_world", eval_poses}};
+}
+
+torch::Tensor manifest_eval_poses(const nlohmann::json& m) {
+  const auto& poses = m.at("eval_camera_to_world");
+  std::vector<double> flat;
+  for (const auto& p : poses)
+    for (const auto& row : p)
+      for (const auto& v : row) flat.push_back(v.get<double>());
+  return torch::tensor(flat, torch::kFloat64)
+      .view({static_cast<int64_t>(poses.size()), 3, 4})
+      .to(torch::kFloat32);
+}
+
+data::Intrinsics manifest_intrinsics(const nlohmann::json& m, int64_t eval_index) {
+  if (eval_index < 0) return intrinsics_from_json(m.at("default_intrinsics"), "data.json");
+  return intrinsics_from_json(m.at("eval_intrinsics").at(static_cast<size_t>(eval_index)),
+                              "data.json");
+}
+
+LoadedRun load_run(const std::string& run_dir, torch::Device device,
+                   const std::string& checkpoint) {
+  std::error_code ec;
+  const std::string config_path = run_file(run_dir, "config.json");
+  const std::string manifest_path = run_file(run_dir, "data.json");
+  require(fs::is_directory(run_dir, ec), run_dir + ": no such run folder; check --run");
+  require(fs::is_regular_file(config_path, ec),
+          run_dir +
+              ": not a training run (no config.json); point --run at a neraf train --out "
+              "folder");
+  LoadedRun run;
+  run.run_dir = run_dir;
+  run.config = train_config_from_json(io::read_json(config_path), config_path);
+  run.manifest = io::read_json(manifest_path);
+  require(run.manifest.value("format", "") == kManifestFormat && run.manifest.contains("num_train"),
+          manifest_path + ": not a neraf run data manifest; re-run neraf train");
+  if (checkpoint.empty()) {
+    const auto latest = latest_checkpoint(run_dir);
+    require(latest.has_value(),
+            run_dir + ": no checkpoint yet; train first (neraf train --out " + run_dir + ")");
+    run.checkpoint = *latest;
+  } else {
+    run.checkpoint = checkpoint;
+  }
+  if (run.config.model.precision == nerf::Precision::bf16 && !nerf::cpu_supports_bf16())
+    run.config.model.precision = nerf::Precision::fp32;  // same weights, no slow bf16 emulation
+  run.model = nerf::NerfactoModel(run.config.model, run.manifest["num_train"].get<int64_t>(),
+                                  run.config.seed);
+  torch::serialize::InputArchive a;
+  load_archive(a, run.checkpoint);
+  check_checkpoint_header(a, run.config, run.checkpoint);
+  try {
+    torch::serialize::InputArchive branch, model;
+    a.read("branch_vision", branch);
+    branch.read("model", model);
+    load_module(*run.model, model, run.checkpoint);
+    torch::Tensor step;
+    a.read("step", step);
+    run.step = step.item<int64_t>();
+  } catch (const c10::Error& e) {
+    std::string what = e.what_without_backtrace();
+    throw Error(run.checkpoint + ": checkpoint does not match the run's config (" +
+                what.substr(0, what.find('\n')) + "); it belongs to another run");
+  }
+  run.model->to(device);
+  run.model->eval();
+  return run;
+}
+
+}  // namespace neraf::infer

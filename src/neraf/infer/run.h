@@ -1,0 +1,47 @@
+#pragma once
+// A training run folder:
+//   RUN/config.json                   the resolved TrainConfig (what --resume, render and eval use)
+//   RUN/data.json                     data manifest: dataset path, frames, image size, the world
+//                                     normalisation and the eval cameras (render needs no dataset)
+//   RUN/checkpoints/step-*.pt         atomic checkpoints (periodic, final, and on Ctrl-C)
+// train/run_training.h drives a Trainer over such a folder; load_run() gives render/eval the
+// model, and the manifest helpers read the eval cameras back.
+#include <torch/torch.h>
+
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "neraf/data/image_set.h"
+#include "neraf/infer/train_config.h"
+#include "neraf/nerf/nerfacto_model.h"
+
+namespace neraf::infer {
+
+// The data manifest written to RUN/data.json.
+nlohmann::json make_data_manifest(const data::ImageSet& images, const std::string& data_dir);
+
+// A trained run, ready for rendering (model in eval mode on `device`).
+struct LoadedRun {
+  std::string run_dir;
+  TrainConfig config;
+  nlohmann::json manifest;  // RUN/data.json
+  std::string checkpoint;
+  int64_t step = 0;
+  nerf::NerfactoModel model{nullptr};
+};
+// Latest checkpoint of RUN (or `checkpoint` if given). neraf::Error when RUN is not a run folder,
+// has no checkpoint, or the checkpoint is corrupted / from another config.
+LoadedRun load_run(const std::string& run_dir, torch::Device device = torch::kCPU,
+                   const std::string& checkpoint = "");
+
+// The eval cameras stored in the manifest: c2w [N, 3, 4] (normalised frame) and intrinsics.
+torch::Tensor manifest_eval_poses(const nlohmann::json& manifest);
+// eval_index −1: the default camera (first training frame).
+data::Intrinsics manifest_intrinsics(const nlohmann::json& manifest, int64_t eval_index);
+// {"fx","fy","cx","cy","width","height"[,"k1","k2","k3","p1","p2"]} ↔ Intrinsics (checked;
+// errors name `where`).
+data::Intrinsics intrinsics_from_json(const nlohmann::json& j, const std::string& where);
+nlohmann::json intrinsics_json(const data::Intrinsics& k);
+
+}  // namespace neraf::infer

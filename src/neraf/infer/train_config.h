@@ -1,0 +1,179 @@
+#pragma once
+// Training configuration: presets `cpu` (default) and `paper`, resolved once and saved beside the
+// run as RUN/config.json (JSON round trip through the same field tables as the model config).
+// It lives in infer/ because loading a finished run reads it; `neraf train` resolves it from its
+// flags with resolve_train_config (the one place the per-modality preset rules live).
+#include <cstdint>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "neraf/nerf/config.h"
+
+namespace neraf::infer {
+
+// What a run trains. Only `vision` is implemented here; `audio` and `joint` are the acoustic
+// branch's (see trainer.h, "Adding a branch").
+enum class Modality { vision, audio, joint };
+std::string to_string(Modality m);
+Modality parse_enum(Modality, const std::string& s, const std::string& where);
+Modality parse_modality(const std::string& s);
+
+// nerfstudio ExponentialDecayScheduler: optional warm-up from lr_pre_warmup (linear, or a sine
+// ramp when warmup_ramp = "sine"), then log-linear from lr to lr_final over
+// [warmup_steps, max_steps], flat afterwards. Adam with this eps (betas 0.9/0.999, no decay).
+struct ScheduleConfig {
+  double lr = 1e-2;
+  double lr_final = 1e-4;
+  int64_t max_steps = 200000;
+  int64_t warmup_steps = 0;
+  double lr_pre_warmup = 1e-8;
+  std::string warmup_ramp = "linear";  // "linear" | "sine"
+  double eps = 1e-15;
+
+  template <class V>
+  void visit(V& v) {
+    v("lr", lr);
+    v("lr_final", lr_final);
+    v("max_steps", max_steps);
+    v("warmup_steps", warmup_steps);
+    v("lr_pre_warmup", lr_pre_warmup);
+    v("warmup_ramp", warmup_ramp);
+    v("eps", eps);
+  }
+};
+
+struct AudioConfig {
+  std::string grid = "sampled";     // sampled | none | zeros (the paper's ablations, --grid)
+  int64_t start_step = 2000;        // audio losses from the step AFTER this one (reference: 2000)
+  int64_t batch_size = 2048;        // (RIR, frame) slices per audio step
+  int64_t grid_resolution = 32;     // S (cpu 32, paper 128)
+  int64_t cells_per_update = 4096;  // grid cells written per training step (round robin)
+  int64_t nacf_width = 0;           // 0: the acoustic preset's NAcF trunk; else N layers of this
+  int64_t nacf_layers = 5;          //    width (only used when nacf_width > 0)
+  double fraction = 1.0;  // few-shot: seeded fraction of the train RIRs used (--audio-fraction)
+  // Energy-decay loss (the paper's "++" variant, off in the reference): its weight (0 = off,
+  // --decay-loss) and how many whole RIRs (all frames) per audio step it is computed on.
+  double decay_weight = 0.0;
+  int64_t decay_rirs = 4;
+  // Share of each audio batch drawn from the first early_frames frames (0 = the reference's
+  // uniform slices). The direct sound and early reflections, which carry the binaural level
+  // differences, C50 and EDT, are a few frames of ~100: uniform slices rarely show them.
+  double early_fraction = 0.0;
+  int64_t early_frames = 12;
+  // Per-frame energy gains fitted on the train RIRs, applied at inference (ours, off in the
+  // paper preset; acoustic/calibration.h).
+  bool energy_calibration = true;
+  // NAcF also sees the source's direction and distance relative to the listener (ours, off in the
+  // paper preset; acoustic/nacf.h, encode_relative_geometry).
+  bool relative_geometry = true;
+  // Highest frequency exponent of the mic/source position encoding (reference 8).
+  double position_max_freq_exp = 8.0;
+  std::string vision_run;  // modality audio: the finished vision run whose field is frozen
+  // "audio_fields" group: NAcF + ResNet3D (+ the radiance field in joint mode), Adam eps 1e-15,
+  // sine warm-up from 1e-8 over warmup_steps then log-linear decay (neraf-reference.md §2.3).
+  ScheduleConfig schedule{1e-4, 1e-8, 1002000, 2000, 1e-8, "sine", 1e-15};
+
+  template <class V>
+  void visit(V& v) {
+    v("grid", grid);
+    v("start_step", start_step);
+    v("batch_size", batch_size);
+    v("grid_resolution", grid_resolution);
+    v("cells_per_update", cells_per_update);
+    v("nacf_width", nacf_width);
+    v("nacf_layers", nacf_layers);
+    v("fraction", fraction);
+    v("decay_weight", decay_weight);
+    v("decay_rirs", decay_rirs);
+    v("early_fraction", early_fraction);
+    v("early_frames", early_frames);
+    v("energy_calibration", energy_calibration);
+    v("relative_geometry", relative_geometry);
+    v("position_max_freq_exp", position_max_freq_exp);
+    v("vision_run", vision_run);
+    v("schedule", schedule);
+  }
+};
+
+struct TrainConfig {
+  std::string preset = "cpu";
+  Modality modality = Modality::vision;
+  int64_t steps = 3000;           // total optimisation steps
+  int64_t rays_per_batch = 4096;  // vision rays per step
+  uint64_t seed = 42;
+  int threads = 0;           // 0: LibTorch's default (all cores)
+  int64_t save_every = 500;  // checkpoint period in steps (and always at the end)
+  int64_t eval_rays_per_chunk = 16384;
+  ScheduleConfig fields;             // "fields" group: the radiance field
+  ScheduleConfig proposal_networks;  // "proposal_networks" group
+  ScheduleConfig camera_opt{1e-3, 1e-4, 5000};
+  nerf::ModelConfig model;
+  AudioConfig audio;  // the acoustic branch (modality audio / joint)
+
+  template <class V>
+  void visit(V& v) {
+    v("preset", preset);
+    v("modality", modality);
+    v("steps", steps);
+    v("rays_per_batch", rays_per_batch);
+    v("seed", seed);
+    v("threads", threads);
+    v("save_every", save_every);
+    v("eval_rays_per_chunk", eval_rays_per_chunk);
+    v("fields", fields);
+    v("proposal_networks", proposal_networks);
+    v("camera_opt", camera_opt);
+    v("model", model);
+    v("audio", audio);
+  }
+};
+
+// Sets c.steps; schedules whose decay was tied to the run length (max_steps == c.steps) follow.
+void set_run_length(TrainConfig& c, int64_t steps);
+
+// The named preset (throws neraf::Error naming --preset for unknown names).
+TrainConfig train_preset(const std::string& name);
+
+// What `neraf train` was asked for; an unset optional takes the preset's value for the modality.
+struct TrainFlags {
+  std::string preset = "cpu";                // --preset
+  Modality modality = Modality::joint;       // --modality
+  std::optional<int64_t> steps;              // --steps
+  uint64_t seed = 42;                        // --seed
+  std::optional<int> threads;                // --threads
+  std::optional<int64_t> rays;               // --rays
+  std::optional<nerf::Precision> precision;  // --precision
+  std::string grid = "sampled";              // --grid
+  double audio_fraction = 1.0;               // --audio-fraction
+  std::optional<int64_t> audio_start_step;   // --audio-start-step
+  std::optional<double> decay_loss;          // --decay-loss
+  bool no_relative_geometry = false;         // --no-relative-geometry
+  std::optional<std::string> vision_run;     // --vision-run (stored as an absolute path)
+};
+
+// The config a new run trains with: train_preset(flags.preset), then the modality's defaults,
+// then the flags, in this order:
+//   - run length: cpu joint 3000 steps, vision 2000, audio 1500; paper joint 400001 (NeRAF's
+//     max_num_iterations), vision 30000, audio 398000. cpu schedules whose decay is tied to the
+//     run length follow it (set_run_length), as they follow --steps.
+//   - modality audio (the field is final, the grid is filled once): audio from the first step
+//     (start_step −1) after a warm-up of 100 steps (cpu) or 2000 (paper), capped at half the
+//     audio schedule's length so that a short run still gets a (shorter) warm-up.
+//   - --steps N sets the run length (set_run_length) before that cap.
+//   - --audio-start-step S: start_step = S, and a warm-up that ended where audio started still
+//     ends there (max(0, S)).
+//   - --seed, --grid, --audio-fraction, --decay-loss, --no-relative-geometry, --threads, --rays,
+//     --precision, --vision-run (made absolute) overwrite their setting.
+// neraf::Error naming the flag: --vision-run without --modality audio, an unknown preset.
+// The result is not validated here (run_training validates the config it trains).
+TrainConfig resolve_train_config(const TrainFlags& flags);
+
+nlohmann::json to_json(const TrainConfig& c);
+// Overlays `j` onto a copy of the preset named in j["preset"] (or `cpu`); `where` names the file.
+TrainConfig train_config_from_json(const nlohmann::json& j, const std::string& where);
+
+// Range checks (neraf::Error "<where>.<key>: ...").
+void validate(const TrainConfig& c, const std::string& where);
+
+}  // namespace neraf::infer

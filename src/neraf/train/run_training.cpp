@@ -1,0 +1,181 @@
+#include "neraf/train/run_training.h"
+
+#include <chrono>
+#include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <memory>
+
+#include "neraf/infer/audio_run.h"
+#include "neraf/infer/checkpoint.h"
+#include "neraf/infer/run.h"
+#include "neraf/io/json_file.h"
+#include "neraf/train/trainer.h"
+#include "neraf/util/error.h"
+#include "neraf/util/log.h"
+#include "neraf/util/progress.h"
+
+namespace fs = std::filesystem;
+
+namespace neraf::train {
+
+using infer::Modality;
+using infer::TrainConfig;
+
+namespace {
+
+std::string run_file(const std::string& run_dir, const char* name) {
+  return (fs::path(run_dir) / name).string();
+}
+
+bool folder_has_entries(const fs::path& p) {
+  std::error_code ec;
+  return fs::is_directory(p, ec) && fs::directory_iterator(p, ec) != fs::directory_iterator();
+}
+
+}  // namespace
+
+TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions& options) {
+  const fs::path run(options.run_dir);
+  const std::string config_path = run_file(options.run_dir, "config.json");
+  const std::string manifest_path = run_file(options.run_dir, "data.json");
+  TrainConfig cfg = config_in;
+  std::optional<std::string> resume_from;
+  nlohmann::json old_manifest;
+
+  if (options.resume) {
+    std::error_code ec;
+    require(fs::is_regular_file(config_path, ec),
+            options.run_dir +
+                ": no config.json here, so there is no run to resume; drop --resume "
+                "to start a new run");
+    cfg = infer::train_config_from_json(io::read_json(config_path), config_path);
+    if (options.steps) infer::set_run_length(cfg, *options.steps);
+    if (options.threads) cfg.threads = *options.threads;
+    if (fs::is_regular_file(manifest_path, ec)) old_manifest = io::read_json(manifest_path);
+    resume_from = infer::latest_checkpoint(options.run_dir);
+    if (!resume_from) warn(options.run_dir + ": no checkpoint yet; starting from step 0");
+  } else if (folder_has_entries(run)) {
+    require(options.force, options.run_dir +
+                               ": folder is not empty; pass --resume to continue this run or "
+                               "--force to start over (deletes its checkpoints)");
+    std::error_code ec;
+    fs::remove_all(infer::checkpoint_dir(options.run_dir), ec);
+    fs::remove(config_path, ec);
+    fs::remove(manifest_path, ec);
+  }
+  infer::validate(cfg, "config");
+  if (cfg.threads > 0) torch::set_num_threads(cfg.threads);
+  torch::manual_seed(cfg.seed);  // anything that still draws from the global generator
+
+  std::string data_dir = options.data_dir;
+  if (data_dir.empty() && old_manifest.contains("data")) data_dir = old_manifest["data"];
+  require(!data_dir.empty(), "--data: required (the dataset folder or its transforms.json)");
+  const data::ImageSet images = data::load_transforms_json(data_dir);
+  nlohmann::json manifest = infer::make_data_manifest(images, data_dir);
+  if (!old_manifest.is_null() && resume_from) {
+    for (const char* key : {"num_train", "height", "width", "train_files"})
+      require(old_manifest.value(key, nlohmann::json()) == manifest[key],
+              data_dir + ": differs from the dataset this run was trained on (" + key +
+                  "); resume with the original --data");
+  }
+  // The acoustic branch's RIRs (features cached next to the dataset) and their manifest.
+  std::unique_ptr<data::RirSet> rirs;
+  if (cfg.modality != Modality::vision) {
+    data::RirLoadOptions rload;
+    rload.progress = options.progress;
+    rirs = std::make_unique<data::RirSet>(data::load_rir_set(data_dir, rload));
+    if (!old_manifest.is_null() && resume_from && old_manifest.contains("audio"))
+      infer::check_audio_manifest(old_manifest["audio"], *rirs, data_dir);
+    manifest["audio"] = infer::make_audio_manifest(*rirs);
+  }
+  std::unique_ptr<Trainer> trainer = make_trainer(cfg, &images, options.device, rirs.get());
+  if (resume_from) {
+    trainer->load_checkpoint(*resume_from);
+    info("resuming " + options.run_dir + " from step " +
+         std::to_string(trainer->completed_steps()) + " (" + *resume_from + ")");
+  }
+  // Written only once the checkpoint is known to match, so a refused resume leaves the run as
+  // it was.
+  io::write_json_atomically(config_path, infer::to_json(cfg));
+  io::write_json_atomically(manifest_path, manifest);
+
+  TrainRunSummary summary;
+  summary.start_step = trainer->completed_steps();
+  summary.end_step = summary.start_step;
+  if (summary.start_step >= cfg.steps) {
+    info(options.run_dir + ": already trained to step " + std::to_string(summary.start_step) +
+         "; pass --steps N to train further");
+    if (resume_from) summary.checkpoint = *resume_from;
+    return summary;
+  }
+
+  info("training " + infer::to_string(cfg.modality) + " (preset " + cfg.preset + ", " +
+       std::to_string(images.train.size()) + " train / " + std::to_string(images.eval.size()) +
+       " eval images, " + std::to_string(torch::get_num_threads()) + " threads, " +
+       nerf::to_string(cfg.model.precision) + " MLPs) → " + options.run_dir);
+  Progress progress("train", cfg.steps - summary.start_step,
+                    ProgressOptions{"step", 0.2, 10.0, options.progress});
+  const auto t0 = std::chrono::steady_clock::now();
+  std::deque<double> recent_psnr;
+  double psnr_sum = 0, audio_decay = 0;
+  int64_t rays = 0;
+  for (;;) {
+    const StepResult r = trainer->step();
+    rays += r.rays;
+    summary.end_step = r.step;
+    summary.last_loss = r.loss;
+    if (r.metrics.count("psnr")) {
+      recent_psnr.push_back(r.metrics.at("psnr"));
+      psnr_sum += recent_psnr.back();
+      if (recent_psnr.size() > 50) {
+        psnr_sum -= recent_psnr.front();
+        recent_psnr.pop_front();
+      }
+      summary.last_psnr = psnr_sum / recent_psnr.size();
+    }
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    summary.seconds = elapsed;
+    summary.rays_per_s = elapsed > 0 ? rays / elapsed : 0;
+    // Running means of the audio terms (log-magnitude MSE, energy-decay L1).
+    auto smooth = [&](const char* key, double& value) {
+      if (!r.metrics.count(key)) return;
+      const double x = r.metrics.at(key);
+      value = value == 0 ? x : 0.98 * value + 0.02 * x;
+    };
+    smooth("audio_sl", summary.last_audio_sl);
+    smooth("audio_decay", audio_decay);
+    char status[200];
+    int len = std::snprintf(status, sizeof status, "step %lld  loss %.4f",
+                            static_cast<long long>(r.step), r.loss);
+    if (cfg.modality != Modality::audio)
+      len += std::snprintf(status + len, sizeof status - len, "  PSNR %.2f  %.0f rays/s",
+                           summary.last_psnr, summary.rays_per_s);
+    if (summary.last_audio_sl > 0)
+      len += std::snprintf(status + len, sizeof status - len, "  audio SL %.4f",
+                           summary.last_audio_sl);
+    if (audio_decay > 0)
+      std::snprintf(status + len, sizeof status - len, "  decay %.4f", audio_decay);
+    progress.update(r.step - summary.start_step, status);
+
+    const bool done = r.step >= cfg.steps;
+    const bool stop = options.stop && options.stop->load();
+    if (done || stop || r.step % cfg.save_every == 0) {
+      summary.checkpoint = infer::checkpoint_path(options.run_dir, r.step);
+      trainer->save_checkpoint(summary.checkpoint);
+    }
+    if (stop) {
+      summary.interrupted = true;
+      break;
+    }
+    if (done) break;
+  }
+  progress.finish();
+  if (summary.interrupted)
+    info("interrupted: checkpoint saved at step " + std::to_string(summary.end_step) +
+         "; continue with --resume");
+  return summary;
+}
+
+}  // namespace neraf::train

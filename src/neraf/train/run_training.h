@@ -1,0 +1,43 @@
+#pragma once
+// Training a run folder (layout: infer/run.h): a Trainer (trainer.h) over the dataset, with
+// periodic atomic checkpoints, --resume and a checkpoint on Ctrl-C.
+#include <torch/torch.h>
+
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "neraf/infer/train_config.h"
+
+namespace neraf::train {
+
+struct TrainRunOptions {
+  std::string data_dir;  // dataset folder or transforms.json
+  std::string run_dir;
+  bool resume = false;           // continue from the latest checkpoint in run_dir
+  bool force = false;            // start over in a non-empty run_dir (its checkpoints are deleted)
+  std::optional<int64_t> steps;  // on resume: a new total step count
+  std::optional<int> threads;    // on resume: a different thread count (numbers then differ)
+  bool progress = true;
+  const std::atomic<bool>* stop = nullptr;  // set asynchronously (Ctrl-C) → checkpoint and return
+  torch::Device device = torch::kCPU;
+};
+
+struct TrainRunSummary {
+  int64_t start_step = 0;
+  int64_t end_step = 0;
+  double seconds = 0;  // wall time of the optimisation loop (excluding data loading)
+  double rays_per_s = 0;
+  double last_loss = 0;
+  double last_psnr = 0;      // training-batch PSNR, mean over the last 50 steps
+  double last_audio_sl = 0;  // audio log-magnitude MSE (running mean; 0 before audio starts)
+  bool interrupted = false;
+  std::string checkpoint;  // the last checkpoint written
+};
+
+// Trains `config` (already resolved from preset + flags) into options.run_dir. On resume the
+// run's own config.json is used instead (options.steps/threads may override those two).
+TrainRunSummary run_training(const infer::TrainConfig& config, const TrainRunOptions& options);
+
+}  // namespace neraf::train

@@ -1,0 +1,108 @@
+// Loading a run's acoustic field: the few-shot subset, a vision run refused, and const queries
+// from several threads at once giving the sequential results.
+#include "neraf/infer/audio_run.h"
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include <algorithm>
+#include <thread>
+#include <vector>
+
+#include "audio_test_util.h"
+#include "neraf/infer/checkpoint.h"
+#include "neraf/io/json_file.h"
+#include "neraf/train/trainer.h"
+#include "neraf/util/error.h"
+
+namespace neraf::infer {
+namespace {
+
+using fixtures::make_image_set;
+using fixtures::make_temp_dir;
+using fixtures::tiny_joint_config;
+using fixtures::tiny_rir_set;
+
+TEST(AudioRun, FewShotSubsetIsSeededAndSized) {
+  const std::string dir = make_temp_dir("subset");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  ASSERT_EQ(rirs.train.size(), 5u);
+  EXPECT_EQ(audio_train_subset(rirs, 1.0, 1), rirs.train);
+  const auto s = audio_train_subset(rirs, 0.4, 7);
+  EXPECT_EQ(s.size(), 2u);
+  EXPECT_EQ(s, audio_train_subset(rirs, 0.4, 7));
+  EXPECT_TRUE(std::is_sorted(s.begin(), s.end()));
+  for (int64_t i : s)
+    EXPECT_NE(std::find(rirs.train.begin(), rirs.train.end(), i), rirs.train.end());
+  EXPECT_EQ(audio_train_subset(rirs, 0.01, 7).size(), 1u);
+  EXPECT_THROW(audio_train_subset(rirs, 0.0, 7), Error);
+}
+
+TEST(AudioRun, VisionRunHasNoAcousticField) {
+  const std::string dir = make_temp_dir("visiononly");
+  TrainConfig c = fixtures::tiny_train_config();
+  io::write_json_atomically(dir + "/config.json", to_json(c));
+  EXPECT_THROW(load_audio_run(dir), Error);
+}
+
+// One AudioRun queried from two threads at once gives exactly the sequential predictions (the
+// queries are const and switch no module mode), and the model stays in eval mode.
+TEST(AudioRun, ConcurrentQueriesMatchSequentialOnes) {
+  torch::manual_seed(0);
+  const std::string dir = make_temp_dir("threads");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  const data::ImageSet images = make_image_set();
+  const TrainConfig c = tiny_joint_config();
+  const std::string run_dir = dir + "/run";
+  {
+    auto trainer = train::make_trainer(c, &images, torch::kCPU, &rirs);
+    trainer->step();
+    trainer->save_checkpoint(checkpoint_path(run_dir, 1));
+  }
+  io::write_json_atomically(run_dir + "/config.json", to_json(c));
+  io::write_json_atomically(run_dir + "/data.json", {{"audio", make_audio_manifest(rirs)}});
+  const AudioRun run = load_audio_run(run_dir);
+  ASSERT_TRUE(run.calibration().defined());  // the cpu preset's energy calibration is applied
+  EXPECT_FALSE(run.model()->is_training());
+
+  const size_t n = rirs.rirs.size();
+  auto query = [&](size_t i) {
+    const data::Rir& r = rirs.rirs[i];
+    return run.predict_log_stft(r.mic, r.source, r.heading_deg);
+  };
+  std::vector<torch::Tensor> expected;
+  for (size_t i = 0; i < n; ++i) expected.push_back(query(i));
+  const auto expected_wave =
+      run.predict_waveform(rirs.rirs[0].mic, rirs.rirs[0].source, rirs.rirs[0].heading_deg, 3);
+
+  constexpr int kRounds = 5;
+  std::vector<torch::Tensor> got[2];
+  std::vector<std::vector<float>> got_wave[2];
+  std::string failure[2];
+  auto worker = [&](int k) {
+    try {
+      for (int round = 0; round < kRounds; ++round)
+        for (size_t j = 0; j < n; ++j) got[k].push_back(query(k == 0 ? j : n - 1 - j));
+      got_wave[k] =
+          run.predict_waveform(rirs.rirs[0].mic, rirs.rirs[0].source, rirs.rirs[0].heading_deg, 3);
+    } catch (const std::exception& e) {
+      failure[k] = e.what();
+    }
+  };
+  std::thread a(worker, 0), b(worker, 1);
+  a.join();
+  b.join();
+  for (int k = 0; k < 2; ++k) {
+    ASSERT_EQ(failure[k], "") << "thread " << k;
+    ASSERT_EQ(got[k].size(), kRounds * n);
+    for (size_t q = 0; q < got[k].size(); ++q) {
+      const size_t j = q % n, i = k == 0 ? j : n - 1 - j;
+      EXPECT_TRUE(torch::equal(got[k][q], expected[i])) << "thread " << k << ", query " << q;
+    }
+    EXPECT_EQ(got_wave[k], expected_wave) << "thread " << k;
+  }
+  EXPECT_FALSE(run.model()->is_training());
+}
+
+}  // namespace
+}  // namespace neraf::infer

@@ -1,0 +1,133 @@
+// Exporting a run's acoustic field to MODEL.nrf and querying it through neraf_rt: the same
+// predictions as the LibTorch path (fp32 to float rounding, bf16 storage within its rounding),
+// with the scene feature folded in, for both first-layer layouts (a grid feature or none), and
+// clear errors for damaged files.
+#include "neraf/infer/exported_model.h"
+
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "audio_test_util.h"
+#include "neraf/infer/checkpoint.h"
+#include "neraf/io/json_file.h"
+#include "neraf/train/trainer.h"
+#include "neraf/util/error.h"
+
+namespace neraf::infer {
+namespace {
+
+using fixtures::make_image_set;
+using fixtures::make_temp_dir;
+using fixtures::tiny_joint_config;
+using fixtures::tiny_rir_set;
+
+// A run folder trained for two steps with `config` on the tiny scene.
+std::string make_run(const std::string& dir, const data::RirSet& rirs, const TrainConfig& c) {
+  torch::manual_seed(0);
+  const data::ImageSet images = make_image_set();
+  const std::string run_dir = dir + "/run_" + c.audio.grid;
+  {
+    auto trainer = train::make_trainer(c, &images, torch::kCPU, &rirs);
+    trainer->step();
+    trainer->step();
+    trainer->save_checkpoint(checkpoint_path(run_dir, 2));
+  }
+  io::write_json_atomically(run_dir + "/config.json", to_json(c));
+  io::write_json_atomically(run_dir + "/data.json",
+                            {{"data", rirs.root}, {"audio", make_audio_manifest(rirs)}});
+  return run_dir;
+}
+
+// The dataset's poses plus poses spread over the box: [N, 3], [N, 3], [N].
+struct Poses {
+  torch::Tensor mic, src, yaw;
+};
+Poses poses_of(const data::RirSet& rirs) {
+  std::vector<double> m, s, y;
+  for (const data::Rir& r : rirs.rirs) {
+    m.insert(m.end(), {r.mic.x, r.mic.y, r.mic.z});
+    s.insert(s.end(), {r.source.x, r.source.y, r.source.z});
+    y.push_back(r.heading_deg + 17.0);  // off the trained headings too
+  }
+  const int64_t n = static_cast<int64_t>(y.size());
+  return {torch::tensor(m, torch::kFloat64).view({n, 3}),
+          torch::tensor(s, torch::kFloat64).view({n, 3}), torch::tensor(y, torch::kFloat64)};
+}
+
+void expect_same_predictions(const std::string& grid) {
+  const std::string dir = make_temp_dir("export_" + grid);
+  const data::RirSet rirs = tiny_rir_set(dir);
+  TrainConfig c = tiny_joint_config();
+  c.audio.grid = grid;
+  const AudioRun run = load_audio_run(make_run(dir, rirs, c));
+  ASSERT_TRUE(run.calibration().defined());
+
+  const std::string path = dir + "/model.nrf";
+  const ExportReport report = export_model(run, path);
+  EXPECT_GT(report.file_bytes, 1000);
+  EXPECT_LT(report.max_abs_difference, 1e-4);
+
+  const ExportedModel model = load_exported_model(path);
+  EXPECT_EQ(model.info().channels, run.info().channels);
+  EXPECT_EQ(model.info().max_len, run.info().max_len);
+  EXPECT_EQ(model.info().n_freq, run.info().n_freq);
+  EXPECT_EQ(model.info().sample_rate, run.info().sample_rate);
+  EXPECT_EQ(model.metadata().at("step").get<int64_t>(), 2);
+  EXPECT_EQ(model.metadata().at("data").at("data").get<std::string>(), rirs.root);
+
+  const Poses p = poses_of(rirs);
+  const torch::Tensor expected = run.predict_log_stft_batch(p.mic, p.src, p.yaw);
+  const torch::Tensor got = model.predict_log_stft_batch(p.mic, p.src, p.yaw);
+  ASSERT_EQ(got.sizes(), expected.sizes());
+  // Float32 products in another order (BLAS vs LibTorch): rounding only.
+  EXPECT_LT((got - expected).abs().max().item<double>(), 1e-4) << grid;
+  EXPECT_GT(expected.std().item<double>(), 1e-3);  // not a constant field
+
+  // bf16 storage: the weights rounded to 8 mantissa bits; the predictions stay close (the
+  // runtime computes in fp32 unless the CPU has AMX-BF16).
+  ExportOptions bf16;
+  bf16.bf16 = true;
+  const std::string half = dir + "/model_bf16.nrf";
+  const ExportReport half_report = export_model(run, half, bf16);
+  EXPECT_LT(half_report.file_bytes, report.file_bytes * 0.75);
+  const torch::Tensor rounded =
+      load_exported_model(half).predict_log_stft_batch(p.mic, p.src, p.yaw);
+  EXPECT_LT((rounded - expected).abs().max().item<double>(), 0.1) << grid;
+}
+
+TEST(ExportedModel, SampledGridFoldedIntoTheBiasMatchesLibTorch) {
+  expect_same_predictions("sampled");
+}
+
+TEST(ExportedModel, NoGridMatchesLibTorch) { expect_same_predictions("none"); }
+
+TEST(ExportedModel, DamagedFilesAreOneClearError) {
+  const std::string dir = make_temp_dir("export_bad");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  const AudioRun run = load_audio_run(make_run(dir, rirs, tiny_joint_config()));
+  const std::string path = dir + "/model.nrf";
+  export_model(run, path);
+  const auto size = std::filesystem::file_size(path);
+
+  std::filesystem::copy_file(path, dir + "/cut.nrf");
+  std::filesystem::resize_file(dir + "/cut.nrf", size / 2);
+  try {
+    load_exported_model(dir + "/cut.nrf");
+    FAIL() << "a truncated file loaded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("cut.nrf"), std::string::npos) << e.what();
+  }
+  {
+    std::ofstream f(dir + "/foreign.nrf", std::ios::binary);
+    f << "RIFF this is not a model file at all, just some bytes of another format";
+  }
+  EXPECT_THROW(load_exported_model(dir + "/foreign.nrf"), Error);
+  EXPECT_THROW(load_exported_model(dir + "/missing.nrf"), Error);
+}
+
+}  // namespace
+}  // namespace neraf::infer

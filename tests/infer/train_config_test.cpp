@@ -1,0 +1,183 @@
+// The training config: JSON round trip of the presets, and resolve_train_config's rules (what
+// `neraf train` resolves from its flags).
+#include "neraf/infer/train_config.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "neraf/util/error.h"
+
+namespace neraf::infer {
+namespace {
+
+TrainConfig resolve(const std::string& preset, Modality modality, TrainFlags flags = {}) {
+  flags.preset = preset;
+  flags.modality = modality;
+  return resolve_train_config(flags);
+}
+
+TEST(TrainConfig, JsonRoundTrip) {
+  for (const char* name : {"cpu", "paper"}) {
+    TrainConfig c = train_preset(name);
+    c.seed = 1234;
+    const auto j = to_json(c);
+    const TrainConfig back = train_config_from_json(j, "test");
+    EXPECT_EQ(to_json(back), j);
+    EXPECT_EQ(j["model"]["field"]["grid"]["log2_hashmap_size"],
+              std::string(name) == "paper" ? 19 : 17);
+  }
+  EXPECT_THROW(train_config_from_json(nlohmann::json::parse(R"({"preset": "gpu"})"), "x"),
+               neraf::Error);
+  EXPECT_THROW(train_config_from_json(nlohmann::json::parse(R"({"stepz": 3})"), "x"), neraf::Error);
+}
+
+TEST(ResolveTrainConfig, DefaultFlagsAreTheCpuJointRun) {
+  const TrainConfig c = resolve_train_config(TrainFlags{});
+  EXPECT_EQ(c.preset, "cpu");
+  EXPECT_EQ(c.modality, Modality::joint);
+  EXPECT_EQ(to_json(c).dump(), [] {
+    TrainConfig p = train_preset("cpu");
+    p.modality = Modality::joint;
+    return to_json(p).dump();
+  }());
+}
+
+TEST(ResolveTrainConfig, CpuRunLengthPerModality) {
+  const TrainConfig joint = resolve("cpu", Modality::joint);
+  EXPECT_EQ(joint.steps, 3000);
+  EXPECT_EQ(joint.fields.max_steps, 3000);
+  EXPECT_EQ(joint.proposal_networks.max_steps, 3000);
+  EXPECT_EQ(joint.audio.schedule.max_steps, 3000);
+  EXPECT_EQ(joint.audio.start_step, 1000);
+  EXPECT_EQ(joint.audio.schedule.warmup_steps, 1000);
+
+  // Vision alone: 2000 steps, the tied schedules follow; camera_opt has its own decay.
+  const TrainConfig vision = resolve("cpu", Modality::vision);
+  EXPECT_EQ(vision.steps, 2000);
+  EXPECT_EQ(vision.fields.max_steps, 2000);
+  EXPECT_EQ(vision.proposal_networks.max_steps, 2000);
+  EXPECT_EQ(vision.camera_opt.max_steps, train_preset("cpu").camera_opt.max_steps);
+
+  // Audio on a frozen field: 1500 steps, audio from the first step after a 100-step warm-up.
+  const TrainConfig audio = resolve("cpu", Modality::audio);
+  EXPECT_EQ(audio.steps, 1500);
+  EXPECT_EQ(audio.audio.schedule.max_steps, 1500);
+  EXPECT_EQ(audio.audio.start_step, -1);
+  EXPECT_EQ(audio.audio.schedule.warmup_steps, 100);
+}
+
+TEST(ResolveTrainConfig, PaperRunLengthPerModality) {
+  const TrainConfig paper = train_preset("paper");
+  const TrainConfig joint = resolve("paper", Modality::joint);
+  EXPECT_EQ(joint.steps, 400001);                             // NeRAF's max_num_iterations
+  EXPECT_EQ(joint.fields.max_steps, paper.fields.max_steps);  // nerfstudio's own decay
+  EXPECT_EQ(joint.audio.start_step, 2000);
+  EXPECT_EQ(joint.audio.schedule.max_steps, paper.audio.schedule.max_steps);
+
+  EXPECT_EQ(resolve("paper", Modality::vision).steps, 30000);
+
+  const TrainConfig audio = resolve("paper", Modality::audio);
+  EXPECT_EQ(audio.steps, 398000);
+  EXPECT_EQ(audio.audio.start_step, -1);
+  EXPECT_EQ(audio.audio.schedule.warmup_steps, 2000);
+  EXPECT_EQ(audio.audio.schedule.max_steps, paper.audio.schedule.max_steps);
+  EXPECT_EQ(audio.rays_per_batch, 4096);
+}
+
+TEST(ResolveTrainConfig, AudioWarmupIsCappedAtHalfAShortRun) {
+  TrainFlags f;
+  f.steps = 100;
+  TrainConfig c = resolve("cpu", Modality::audio, f);
+  EXPECT_EQ(c.steps, 100);
+  EXPECT_EQ(c.audio.schedule.max_steps, 100);
+  EXPECT_EQ(c.audio.schedule.warmup_steps, 50);
+  f.steps = 1;
+  c = resolve("cpu", Modality::audio, f);
+  EXPECT_EQ(c.audio.schedule.warmup_steps, 0);
+  // A long run keeps the full warm-up.
+  f.steps = 5000;
+  EXPECT_EQ(resolve("cpu", Modality::audio, f).audio.schedule.warmup_steps, 100);
+  // Joint runs are not capped (audio starts at step 1000, the warm-up ends there).
+  f.steps = 1500;
+  EXPECT_EQ(resolve("cpu", Modality::joint, f).audio.schedule.warmup_steps, 1000);
+}
+
+TEST(ResolveTrainConfig, ExplicitFlagsWin) {
+  TrainFlags f;
+  f.steps = 500;
+  f.seed = 7;
+  f.threads = 3;
+  f.rays = 128;
+  f.precision = nerf::Precision::fp32;
+  f.grid = "zeros";
+  f.audio_fraction = 0.5;
+  f.decay_loss = 0.25;
+  f.no_relative_geometry = true;
+  for (Modality m : {Modality::vision, Modality::joint}) {
+    const TrainConfig c = resolve("cpu", m, f);
+    EXPECT_EQ(c.steps, 500);  // over the modality's default
+    EXPECT_EQ(c.fields.max_steps, 500);
+    EXPECT_EQ(c.audio.schedule.max_steps, 500);
+    EXPECT_EQ(c.seed, 7u);
+    EXPECT_EQ(c.threads, 3);
+    EXPECT_EQ(c.rays_per_batch, 128);
+    EXPECT_EQ(c.model.precision, nerf::Precision::fp32);
+    EXPECT_EQ(c.audio.grid, "zeros");
+    EXPECT_EQ(c.audio.fraction, 0.5);
+    EXPECT_EQ(c.audio.decay_weight, 0.25);
+    EXPECT_FALSE(c.audio.relative_geometry);
+  }
+  // Unset flags keep the preset's values.
+  const TrainConfig cpu = resolve("cpu", Modality::joint);
+  const TrainConfig preset = train_preset("cpu");
+  EXPECT_EQ(cpu.threads, preset.threads);
+  EXPECT_EQ(cpu.rays_per_batch, 2048);
+  EXPECT_EQ(cpu.model.precision, preset.model.precision);
+  EXPECT_EQ(cpu.audio.decay_weight, preset.audio.decay_weight);
+  EXPECT_TRUE(cpu.audio.relative_geometry);
+  EXPECT_EQ(resolve("paper", Modality::joint).seed, 42u);
+}
+
+TEST(ResolveTrainConfig, AudioStartStepMovesAWarmupThatEndedThere) {
+  TrainFlags f;
+  f.audio_start_step = 500;
+  TrainConfig c = resolve("cpu", Modality::joint, f);
+  EXPECT_EQ(c.audio.start_step, 500);
+  EXPECT_EQ(c.audio.schedule.warmup_steps, 500);  // the preset's warm-up ended at step 1000
+  f.audio_start_step = -1;
+  c = resolve("cpu", Modality::joint, f);
+  EXPECT_EQ(c.audio.start_step, -1);
+  EXPECT_EQ(c.audio.schedule.warmup_steps, 0);
+  // A warm-up that did not end at the start (audio: start −1, warm-up 100) stays.
+  f.audio_start_step = 200;
+  c = resolve("cpu", Modality::audio, f);
+  EXPECT_EQ(c.audio.start_step, 200);
+  EXPECT_EQ(c.audio.schedule.warmup_steps, 100);
+}
+
+TEST(ResolveTrainConfig, VisionRunOnlyWithAudioAndAbsolute) {
+  TrainFlags f;
+  f.vision_run = "runs/../runs/vision";
+  for (Modality m : {Modality::vision, Modality::joint}) {
+    try {
+      resolve("cpu", m, f);
+      ADD_FAILURE() << "--vision-run must be refused without --modality audio";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("--vision-run"), std::string::npos) << e.what();
+    }
+  }
+  const TrainConfig c = resolve("cpu", Modality::audio, f);
+  EXPECT_EQ(c.audio.vision_run,
+            (std::filesystem::current_path() / "runs" / "vision").lexically_normal().string());
+  EXPECT_TRUE(resolve("cpu", Modality::audio).audio.vision_run.empty());
+}
+
+TEST(ResolveTrainConfig, UnknownPresetIsAnError) {
+  TrainFlags f;
+  f.preset = "gpu";
+  EXPECT_THROW(resolve_train_config(f), Error);
+}
+
+}  // namespace
+}  // namespace neraf::infer
