@@ -189,7 +189,12 @@ NERAF_CPU(BM_NacfFwdBwd, 1);
 NERAF_CPU(BM_AdamStep, 0);
 NERAF_CPU(BM_RenderStft, 0);
 NERAF_CPU(BM_RenderStft, 1);
+NERAF_CPU(BM_RenderStftCachedFeature, 0);
 NERAF_CPU(BM_RenderStftCachedFeature, 1);
+// The query path of `neraf render`/`eval --run` (fp32) and of bf16, for the runtime comparison
+// (bench/runtime_bench.sh): ~10 ms per call, so several iterations per repetition.
+BENCHMARK(BM_RenderStftCachedFeature)->Args({1, 0})->Unit(benchmark::kMillisecond)->Repetitions(5);
+BENCHMARK(BM_RenderStftCachedFeature)->Args({1, 1})->Unit(benchmark::kMillisecond)->Repetitions(5);
 NERAF_PAPER(BM_AcousticStep, 0);
 NERAF_PAPER(BM_AcousticStep, 1);
 NERAF_PAPER(BM_ResNet3dFwdBwd, 0);

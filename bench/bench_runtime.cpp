@@ -29,7 +29,8 @@ neraf::rt::DenseLayer random_layer(int64_t in, int64_t out, std::mt19937& gen) {
   neraf::rt::DenseLayer l;
   l.in = in;
   l.out = out;
-  std::uniform_real_distribution<float> u(-1.0f / std::sqrt(float(in)), 1.0f / std::sqrt(float(in)));
+  std::uniform_real_distribution<float> u(-1.0f / std::sqrt(float(in)),
+                                          1.0f / std::sqrt(float(in)));
   l.weight.resize(size_t(in * out));
   l.bias.resize(size_t(out));
   for (float& w : l.weight) w = u(gen);
@@ -145,6 +146,11 @@ void BM_Load(benchmark::State& state) {  // read, verify and prepare a model fil
   const fs::path dir = ::mkdtemp(t.data());
   const std::string path = (dir / "model.nrf").string();
   neraf::rt::write_model_file(path, synthetic_model(paper, false));
+  // The file sizes of the preset (they depend on the shapes only): fp32 and bf16 storage.
+  const std::string half = (dir / "model_bf16.nrf").string();
+  neraf::rt::write_model_file(half, synthetic_model(paper, true));
+  state.counters["fp32_file_MB"] = double(fs::file_size(path)) / 1e6;
+  state.counters["bf16_file_MB"] = double(fs::file_size(half)) / 1e6;
   for (auto _ : state) {
     neraf_model* m = nullptr;
     if (neraf_model_load(path.c_str(), &m) != NERAF_OK) state.SkipWithError(neraf_last_error());

@@ -4,7 +4,7 @@ set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libtorch-dev libopenblas0-openmp
-  libsndfile1-dev libsamplerate0-dev libmysofa-dev
+  libsndfile1-dev libsoxr-dev libmysofa-dev
   nlohmann-json3-dev libcli11-dev libstb-dev
   googletest libgtest-dev libbenchmark-dev
   libfftw3-dev espeak-ng

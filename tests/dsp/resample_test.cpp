@@ -43,19 +43,35 @@ TEST(Resample, AboveNewNyquistIsRemoved) {
   EXPECT_LT(db, -60.0) << db << " dB";
 }
 
-TEST(Resample, LengthIsRoundedRatio) {
-  for (size_t n : {size_t(1), size_t(2), size_t(3), size_t(1001), size_t(44100), size_t(44101)}) {
-    EXPECT_EQ(neraf::dsp::resample(std::vector<float>(n, 0.1f), 44100, 22050).size(),
-              size_t(std::llround(n * 0.5)))
-        << n;
-    EXPECT_EQ(neraf::dsp::resample(std::vector<float>(n, 0.1f), 44100, 48000).size(),
-              size_t(std::llround(n * 48000.0 / 44100.0)))
-        << n;
-    EXPECT_EQ(neraf::dsp::resample(std::vector<float>(n, 0.1f), 48000, 22050).size(),
-              size_t(std::llround(n * 22050.0 / 48000.0)))
-        << n;
+// ceil(n · to / from), as librosa's fix_length after soxr (hand-computed).
+TEST(Resample, LengthIsCeilOfTheRatio) {
+  struct Case {
+    size_t n;
+    double from, to;
+    size_t expected;
+  };
+  for (const Case& c :
+       {Case{1, 44100, 22050, 1}, Case{1, 44100, 48000, 2}, Case{1, 48000, 22050, 1},
+        Case{3, 44100, 22050, 2}, Case{3, 44100, 48000, 4}, Case{3, 48000, 22050, 2},
+        Case{44100, 44100, 22050, 22050}, Case{44100, 44100, 48000, 48000},
+        Case{44100, 48000, 22050, 20259}, Case{44101, 44100, 22050, 22051},
+        Case{44101, 44100, 48000, 48002}, Case{44101, 48000, 22050, 20259}}) {
+    EXPECT_EQ(neraf::dsp::resample(std::vector<float>(c.n, 0.1f), c.from, c.to).size(), c.expected)
+        << c.n << " samples " << c.from << " -> " << c.to;
   }
   EXPECT_TRUE(neraf::dsp::resample(std::vector<float>{}, 44100, 22050).empty());
+}
+
+// The filter's delay is compensated: an impulse at 1000 / 44100 s peaks at 500 / 22050 s.
+TEST(Resample, ImpulseStaysInPlace) {
+  std::vector<float> x(4410, 0.0f);
+  x[1000] = 1.0f;
+  const auto y = neraf::dsp::resample(x, 44100, 22050);
+  size_t peak = 0;
+  for (size_t i = 0; i < y.size(); ++i)
+    if (std::abs(y[i]) > std::abs(y[peak])) peak = i;
+  EXPECT_EQ(peak, 500u);
+  EXPECT_NEAR(y[peak], 0.5f, 0.05f);  // half the energy is above the new Nyquist frequency
 }
 
 TEST(Resample, SameRateIsIdentityAndBuffersKeepChannels) {

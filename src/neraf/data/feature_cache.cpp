@@ -28,7 +28,8 @@ namespace neraf::data {
 namespace {
 
 constexpr char kMagic[8] = {'N', 'R', 'F', 'F', 'E', 'A', 'T', '1'};
-constexpr int kVersion = 1;
+// 2: SoundSpaces features resampled with libsoxr HQ (librosa's soxr_hq), was libsamplerate.
+constexpr int kVersion = 2;
 
 int64_t round_up(int64_t v, int64_t m) { return (v + m - 1) / m * m; }
 

@@ -5,7 +5,7 @@
 // File layout (little-endian):
 //   [0, 8)               magic "NRFFEAT1"
 //   [8, 16)              uint64 n = byte length of the JSON header
-//   [16, 16 + n)         JSON header: {"format": "neraf-features", "version": 1, "key": "<hex>",
+//   [16, 16 + n)         JSON header: {"format": "neraf-features", "version": 2, "key": "<hex>",
 //                        "layout", "n_rirs", "channels", "n_freq", "max_len",
 //                        "dtype": "float32" | "float16", "lengths_offset", "data_offset",
 //                        "description": the text the key hashes (parameters + file list summary)}

@@ -1,6 +1,6 @@
 #include "neraf/dsp/resample.h"
 
-#include <samplerate.h>
+#include <soxr.h>
 
 #include <cmath>
 #include <string>
@@ -16,7 +16,7 @@ void check_rates(double from_hz, double to_hz) {
                                             std::to_string(from_hz) + " Hz -> " +
                                             std::to_string(to_hz) + " Hz)");
   const double ratio = to_hz / from_hz;
-  // libsamplerate's limit on the conversion ratio.
+  // A sane bound on the conversion ratio (soxr allows more; nothing here needs it).
   require(ratio >= 1.0 / 256.0 && ratio <= 256.0,
           "resample: cannot convert " + std::to_string(from_hz) + " Hz to " +
               std::to_string(to_hz) + " Hz (ratio beyond 1:256)");
@@ -26,27 +26,29 @@ void check_rates(double from_hz, double to_hz) {
 
 std::vector<float> resample(const std::vector<float>& x, double from_hz, double to_hz) {
   check_rates(from_hz, to_hz);
-  const double ratio = to_hz / from_hz;
-  const size_t out_len = static_cast<size_t>(std::llround(double(x.size()) * ratio));
   if (from_hz == to_hz) return x;
   if (x.empty()) return {};
-
-  // One call over the whole signal (src_simple flushes the filter at the end of input), into a
-  // buffer with a little slack; then exactly round(n·to/from) samples are kept, zero-padding the
-  // at most few samples libsamplerate leaves out at the very end.
-  std::vector<float> out(out_len + 16, 0.0f);
-  SRC_DATA d{};
-  d.data_in = x.data();
-  d.input_frames = static_cast<long>(x.size());
-  d.data_out = out.data();
-  d.output_frames = static_cast<long>(out.size());
-  d.src_ratio = ratio;
-  const int rc = src_simple(&d, SRC_SINC_BEST_QUALITY, 1);
-  require(rc == 0, std::string("resample: libsamplerate failed: ") + src_strerror(rc));
-  out.resize(out_len);
-  if (static_cast<size_t>(d.output_frames_gen) < out_len) {
-    std::fill(out.begin() + d.output_frames_gen, out.end(), 0.0f);
+  // ceil(n·to/from), exactly when both rates are whole numbers (the usual case).
+  const double n = static_cast<double>(x.size());
+  size_t out_len = 0;
+  if (from_hz == std::floor(from_hz) && to_hz == std::floor(to_hz) && from_hz < 1e9 &&
+      to_hz < 1e9) {
+    const auto from = static_cast<unsigned long long>(from_hz);
+    const auto to = static_cast<unsigned long long>(to_hz);
+    out_len = static_cast<size_t>((x.size() * to + from - 1) / from);
+  } else {
+    out_len = static_cast<size_t>(std::ceil(n * (to_hz / from_hz)));
   }
+  std::vector<float> out(out_len, 0.0f);
+  // One call over the whole signal; soxr flushes its filter at the end of input and compensates
+  // its delay, so out[k] is aligned with x at time k / to_hz. The at most few samples it leaves
+  // out at the very end stay zero.
+  const soxr_quality_spec_t quality = soxr_quality_spec(SOXR_HQ, 0);
+  const soxr_io_spec_t io = soxr_io_spec(SOXR_FLOAT32_I, SOXR_FLOAT32_I);
+  size_t done = 0;
+  const soxr_error_t error = soxr_oneshot(from_hz, to_hz, 1, x.data(), x.size(), nullptr,
+                                          out.data(), out.size(), &done, &io, &quality, nullptr);
+  require(!error, std::string("resample: libsoxr failed: ") + soxr_strerror(error));
   return out;
 }
 
@@ -56,7 +58,7 @@ io::AudioBuffer resample(const io::AudioBuffer& audio, int to_hz) {
   out.sample_rate = to_hz;
   out.channels.resize(audio.channels.size());
   const int n_ch = audio.num_channels();
-  // Channels are independent conversions (libsamplerate keeps no shared state).
+  // Channels are independent conversions (soxr_oneshot keeps no shared state).
 #pragma omp parallel for schedule(static) if (n_ch > 1)
   for (int c = 0; c < n_ch; ++c) {
     out.channels[c] = resample(audio.channels[c], audio.sample_rate, to_hz);

@@ -1,6 +1,8 @@
 #pragma once
-// Sample-rate conversion with libsamplerate at its best quality (SRC_SINC_BEST_QUALITY).
-// Output length round(n · to / from).
+// Sample-rate conversion with libsoxr at its "HQ" quality (SOXR_HQ, one call over the whole
+// signal): what librosa 0.10's default `res_type="soxr_hq"` runs, so the SoundSpaces loaders
+// resample 44.1 → 22.05 kHz as the published code does. Output length ceil(n · to / from), as
+// librosa's fix_length after soxr.
 #include <vector>
 
 #include "neraf/io/audio_file.h"

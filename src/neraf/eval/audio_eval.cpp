@@ -141,6 +141,7 @@ std::vector<int64_t> nearest_training_rirs(const data::RirSet& train_set,
 AudioMethodEval evaluate_audio_model(const infer::AudioField& run, const data::RirSet& rirs,
                                      const std::vector<int64_t>& test, const std::string& label,
                                      const AudioEvalOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
   AudioMethodEval m;
   m.name = label;
   m.per_rir.resize(test.size());
@@ -166,6 +167,7 @@ AudioMethodEval evaluate_audio_model(const infer::AudioField& run, const data::R
   });
   progress.finish();
   m.summary = metrics::summarize(m.per_rir);
+  m.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return m;
 }
 
@@ -190,7 +192,8 @@ AudioEval evaluate_audio(const infer::AudioField& run, const data::RirSet& train
   if (options.baselines) {
     require(!train_subset.empty(), "baselines: no training RIRs");
     const metrics::Variant variant = variant_of(test_set);
-    AudioMethodEval nearest{"nearest", {}, {}}, linear{"linear", {}, {}};
+    const auto t_baselines = std::chrono::steady_clock::now();
+    AudioMethodEval nearest{"nearest", {}, {}, 0}, linear{"linear", {}, {}, 0};
     nearest.per_rir.resize(test.size());
     linear.per_rir.resize(test.size());
     Progress progress("eval audio (baselines)", static_cast<int64_t>(test.size()),
@@ -226,6 +229,8 @@ AudioEval evaluate_audio(const infer::AudioField& run, const data::RirSet& train
     });
     progress.finish();
     nearest.summary = metrics::summarize(nearest.per_rir);
+    nearest.seconds = linear.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t_baselines).count();
     linear.summary = metrics::summarize(linear.per_rir);
     e.methods.push_back(std::move(nearest));
     e.methods.push_back(std::move(linear));
@@ -253,7 +258,10 @@ nlohmann::json to_json(const metrics::RirErrorSummary& s) {
 
 nlohmann::json to_json(const AudioEval& e) {
   nlohmann::json j = nlohmann::json::object();
-  for (const auto& m : e.methods) j[m.name] = to_json(m.summary);
+  for (const auto& m : e.methods) {
+    j[m.name] = to_json(m.summary);
+    j[m.name]["seconds"] = m.seconds;
+  }
   return j;
 }
 

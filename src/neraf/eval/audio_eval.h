@@ -49,6 +49,7 @@ struct AudioMethodEval {
   std::string name;  // "neraf", "nearest", "linear" or an ablation label
   std::vector<metrics::RirErrors> per_rir;
   metrics::RirErrorSummary summary;
+  double seconds = 0;  // wall time of the scoring (the two baselines: of both together)
 };
 
 struct AudioEval {
@@ -75,7 +76,7 @@ AudioMethodEval evaluate_audio_model(const infer::AudioField& run, const data::R
 // {"t60_error_pct", "c50_error_db", "edt_error_s", "stft_error", "invalid_t60", "n_rirs",
 //  "<key>_std" ...}
 nlohmann::json to_json(const metrics::RirErrorSummary& s);
-// {"neraf": {...}, "nearest": {...}, "linear": {...}}
+// {"neraf": {..., "seconds"}, "nearest": {...}, "linear": {...}}
 nlohmann::json to_json(const AudioEval& e);
 // neraf against each baseline on the same RIRs (metrics::paired_difference of the T60, C50 and
 // EDT errors, neraf − baseline): {"nearest": {"t60_error_pct": {"mean_difference",

@@ -1,6 +1,6 @@
 #pragma once
 // Inference of an exported acoustic field: pose → log-STFT [C, F, T] → waveform [C, rir_length],
-// the numbers of the training code's render path (train::AudioRun::predict_log_stft, then
+// the numbers of the training code's render path (infer::AudioRun::predict_log_stft_batch, then
 // Griffin-Lim) without LibTorch.
 //
 // One RIR is T frames of the same pose, so the first layer splits (inputs [time | pose]):

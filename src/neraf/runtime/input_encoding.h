@@ -23,7 +23,7 @@ std::array<float, kNumFrequencies> encoding_frequencies(double max_exp);
 std::array<double, 3> normalize_position(const double p[3], const std::array<double, 3>& box_min,
                                          const std::array<double, 3>& box_max);
 
-// ((cosθ+1)/2, 0.5, (sinθ+1)/2), θ = yaw_deg·π/180 (train::AudioRun::predict_log_stft).
+// ((cosθ+1)/2, 0.5, (sinθ+1)/2), θ = yaw_deg·π/180 (infer::AudioRun::predict_log_stft_batch).
 std::array<double, 3> rot_from_yaw(double yaw_deg);
 
 // out[21]: frame t of T (t/(T − 1) in float, the encoding in float).
