@@ -15,7 +15,7 @@
 // RAF), encoded as ((cos+1)/2, 0.5, (sin+1)/2). Positions outside the train audio aabb are zeroed
 // (the reference's rule) — the prediction is then meaningless; check info().aabb.
 // Batch many poses with predict_log_stft_batch (one NAcF call per pose, the scene feature is
-// computed once at load).
+// computed once at load). Queries run NAcF in fp32 whatever precision trained the run.
 //
 // Threads: every query is const and may run from several threads at once on one AudioRun. The
 // model is put in eval mode once, at load; a query runs NAcF on the scene feature computed then
