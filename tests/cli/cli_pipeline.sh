@@ -114,7 +114,7 @@ expect_in "$TMP/err" "cut.nrf"
 expect_exit 2 "$NERAF" render rir --run "$R" --model "$M" --mic "$MIC" --src "$SRC" --out "$TMP/x.wav"
 
 # --- many poses, trajectories ------------------------------------------------------------------
-expect_exit 0 "$NERAF" render rir --model "$M" --poses "$EX/demo_poses.json" --out "$TMP/rirs"
+expect_exit 0 "$NERAF" render rir --model "$M" --poses "$EX/demo_poses.json" --out "$TMP/rirs/"
 expect_file "$TMP/rirs/summary.csv"
 expect_file "$TMP/rirs/near_source.wav"
 expect_file "$TMP/rirs/pose_0005.wav"

@@ -72,6 +72,20 @@ TEST_F(AtomicFileTest, ReadErrorsNameTheFile) {
   }
 }
 
+// Found by fuzz/fuzz_json_file: nlohmann reports a number beyond a double (1e309) as out_of_range,
+// not parse_error; it escaped read_json as a raw nlohmann exception without the file's name.
+TEST_F(AtomicFileTest, JsonNumberOverflowIsAnErrorNamingTheFile) {
+  fs::create_directories(dir_);
+  const std::string huge = (dir_ / "huge.json").string();
+  write_text_atomically(huge, "{\"a\": [1, -21e309]}");
+  try {
+    read_json(huge);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("huge.json: not valid JSON"), std::string::npos);
+  }
+}
+
 TEST_F(AtomicFileTest, JsonRoundTrip) {
   const std::string path = (dir_ / "x.json").string();
   nlohmann::json value = {{"fs", 22050}, {"channels", {1.5, 2.5}}};

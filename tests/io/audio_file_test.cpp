@@ -204,6 +204,47 @@ TEST_F(AudioFileTest, TruncatedSampleDataIsRejected) {
   }
 }
 
+namespace {
+
+// `flac` (a file as write_audio writes it: STREAMINFO first) announcing `total` samples: the low 36
+// bits of bytes 18..25 (sample rate, channels, bits per sample, total samples; big-endian).
+std::string with_flac_total_samples(std::string flac, uint64_t total) {
+  uint64_t v = 0;
+  for (int i = 18; i < 26; ++i) v = (v << 8) | static_cast<unsigned char>(flac[i]);
+  v = (v & ~((uint64_t(1) << 36) - 1)) | total;
+  for (int i = 25; i >= 18; --i, v >>= 8) flac[i] = static_cast<char>(v & 0xFF);
+  return flac;
+}
+
+}  // namespace
+
+// Found by fuzz/fuzz_audio_file: libsndfile reports SF_COUNT_MAX frames for a stream of unknown
+// length (a FLAC written through a pipe has total_samples 0; an Ogg file without its last page),
+// and read_audio allocated that many samples (std::length_error escaped).
+TEST_F(AudioFileTest, FlacOfUnknownLengthIsReadToTheEnd) {
+  const std::string good = path("good.flac");
+  const AudioBuffer a = random_audio(2, 3000, 22050, 4);
+  neraf::io::write_audio(good, a);
+  std::ifstream in(good, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  ASSERT_EQ(bytes.substr(0, 4), "fLaC");
+  const std::string p = path("streamed.flac");
+  std::ofstream(p, std::ios::binary) << with_flac_total_samples(bytes, 0);
+  expect_close(neraf::io::read_audio(p), a, 1.0f / (1 << 22));
+}
+
+// Found by fuzz/fuzz_audio_file: a damaged header announcing 2^35 frames made read_audio allocate
+// them all (128 GiB per channel) before reading; now it reads what is there and reports truncation.
+TEST_F(AudioFileTest, ImplausibleFrameCountIsTruncationNotAnAllocation) {
+  const std::string good = path("good.flac");
+  neraf::io::write_audio(good, random_audio(2, 3000, 22050, 5));
+  std::ifstream in(good, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  const std::string p = path("claims_2pow35.flac");
+  std::ofstream(p, std::ios::binary) << with_flac_total_samples(bytes, uint64_t(1) << 35);
+  expect_error([&] { neraf::io::read_audio(p); }, {p, "truncated"});
+}
+
 TEST_F(AudioFileTest, TextFileRenamedWavIsNotAudio) {
   const std::string p = path("notes.wav");
   std::ofstream(p) << "these are meeting notes, not a recording\n";

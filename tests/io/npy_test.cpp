@@ -114,6 +114,28 @@ TEST_F(NpyTest, RejectsWhatItCannotReadWithClearErrors) {
   expect_error_naming(
       write("t.npy", "{'descr': '<f4', 'fortran_order': False, 'shape': (8,), }", v, 16),
       "truncated");
+  // Found by fuzz/fuzz_npy: shapes whose element count overflows int64 (signed overflow, then a
+  // wrapped size of 0 or a negative one that passed the truncation check).
+  expect_error_naming(write("huge1.npy",
+                            "{'descr': '<f4', 'fortran_order': False, "
+                            "'shape': (4611686018427387904, 4), }",
+                            v, 16),
+                      "too large");
+  expect_error_naming(write("huge2.npy",
+                            "{'descr': '<f4', 'fortran_order': False, "
+                            "'shape': (4611686018427387903,), }",
+                            v, 16),
+                      "too large");
+  expect_error_naming(write("huge3.npy",
+                            "{'descr': '<f8', 'fortran_order': False, "
+                            "'shape': (3037000500, 3037000500), }",
+                            v, 16),
+                      "too large");
+  expect_error_naming(write("huge4.npy",
+                            "{'descr': '<f4', 'fortran_order': False, "
+                            "'shape': (46116860, 84273879116860, 0), }",
+                            v, 16),
+                      "too large");
   const std::string txt = (fs::path(dir_) / "x.npy").string();
   std::ofstream(txt) << "not numpy at all";
   expect_error_naming(txt, "not a NumPy .npy file");

@@ -263,6 +263,29 @@ TEST(ModelFile, WriterRejectsInvalidModels) {
   rejects(m, "bfloat16");
 }
 
+// Found while writing fuzz/fuzz_c_api: with waveform_length 0 the RIR length hop·(T − 1) had no
+// bound of its own (up to 65535·65535), so a 263 KB file made neraf_model_load allocate ~31 GB of
+// Griffin-Lim buffers, and neraf_model_info.rir_length (an int) would have overflowed.
+TEST(ModelFile, ImplicitRirLengthIsBoundedLikeAnExplicitOne) {
+  RandomModelOptions o;
+  o.channels = 1;
+  o.n_fft = o.win_length = 65536;
+  o.hop_length = 60000;
+  o.max_len = 65536;  // 60000 · 65535 ≈ 3.9e9 samples
+  o.trunk = {1};
+  o.calibration = false;
+  const ModelData m = random_model(o);
+  try {
+    serialize_model(m, "long.nrf");
+    ADD_FAILURE() << "accepted a RIR of " << m.rir_length() << " samples";
+  } catch (const ModelFileError& e) {
+    EXPECT_EQ(e.status(), NERAF_ERR_FORMAT);
+    EXPECT_NE(std::string(e.what()).find("RIR length"), std::string::npos) << e.what();
+  }
+  o.max_len = (1 << 26) / 60000 + 1;  // the largest T within the bound is still a model
+  EXPECT_NO_THROW(serialize_model(random_model(o), "long.nrf"));
+}
+
 TEST(ModelFile, ReadErrorsNameTheFile) {
   TempDir dir;
   auto status_of = [](const std::string& path, std::string* message) {

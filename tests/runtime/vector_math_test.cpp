@@ -35,6 +35,18 @@ TEST(VectorMath, TanhAbsoluteErrorBelow1p5e7) {
   EXPECT_EQ(tanh_approx(-30.0f), -1.0f);
 }
 
+// Found by fuzz/fuzz_c_api: a model whose finite weights overflow to inf - inf gives NaN
+// activations, and exp_approx converted NaN to int32 (undefined behaviour, UBSan's
+// float-cast-overflow). NaN must come out as NaN.
+TEST(VectorMath, NanGivesNan) {
+  const float nan = std::nanf("");
+  EXPECT_TRUE(std::isnan(exp_approx(nan)));
+  EXPECT_TRUE(std::isnan(exp_approx(-nan)));
+  EXPECT_TRUE(std::isnan(tanh_approx(nan)));
+  EXPECT_EQ(exp_approx(-1e30f), exp_approx(-87.0f));  // the clamps themselves are unchanged
+  EXPECT_EQ(exp_approx(1e30f), exp_approx(88.0f));
+}
+
 TEST(InputEncoding, FrequenciesAreTorchsFloat32Ones) {
   const auto f = neraf::rt::encoding_frequencies(8.0);
   EXPECT_EQ(f[0], 1.0f);

@@ -192,6 +192,19 @@ TEST(SceneJson, SourcesAndMicrophonesMustBeInFreeSpace) {
       << light;
 }
 
+// Found by fuzz/fuzz_scene_json: the microphone grid was built before its size was checked, so a
+// tiny spacing overflowed the int point count (undefined behaviour) or made billions of points.
+TEST(SceneJson, TinyGridSpacingIsAnErrorNotBillionsOfPoints) {
+  for (const double spacing : {1e-9, 5e-4, 1e-300}) {
+    const std::string e =
+        error_with([&](json& j) { j["microphones"]["grid"]["spacing_m"] = spacing; });
+    EXPECT_EQ(e.rfind("scene.json: microphones.grid.spacing_m: gives ", 0), 0u) << e;
+    EXPECT_NE(e.find("use a larger spacing"), std::string::npos) << e;
+  }
+  const std::string huge_room = error_with([](json& j) { j["size"] = {1e7, 3, 1e7}; });
+  EXPECT_EQ(huge_room.rfind("scene.json: microphones.grid.spacing_m: gives ", 0), 0u) << huge_room;
+}
+
 TEST(SceneJson, DefaultsFillEverything) {
   const Scene s = scene_from_json(json::object(), "empty.json");
   EXPECT_DOUBLE_EQ(s.size.x, 5);

@@ -117,7 +117,8 @@ void render_pose_list(const LoadedField& field, const FieldArgs& field_args,
     check_inside(poses[i].source, where + " source", info.aabb, field_args.allow_outside);
   }
   std::error_code ec;
-  const fs::path out = fs::path(out_dir).lexically_normal();
+  fs::path out = fs::path(out_dir).lexically_normal();
+  if (!out.has_filename()) out = out.parent_path();  // "rirs/" names the folder rirs
   require(!fs::exists(out, ec) || (fs::is_directory(out, ec) && fs::is_empty(out, ec)),
           out_dir + ": exists and is not an empty folder; choose a new --out folder or remove it");
   const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");

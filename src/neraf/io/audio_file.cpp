@@ -91,20 +91,33 @@ AudioBuffer read_audio(const std::string& path) {
   AudioBuffer out;
   out.sample_rate = info.samplerate;
   const int nc = info.channels;
-  out.channels.assign(nc, std::vector<float>(static_cast<size_t>(info.frames)));
+  // The header's frame count is a claim, not a size to allocate: libsndfile reports SF_COUNT_MAX
+  // for a stream of unknown length (e.g. an Ogg file without its last page), and a damaged header
+  // can announce billions of frames. Reserve at most one frame per byte of the file (what nearly
+  // every real file needs at most) and grow with what is actually decoded.
+  const bool length_known = info.frames != SF_COUNT_MAX;
+  const sf_count_t size_bound =
+      ec ? kChunkFrames : static_cast<sf_count_t>(std::min<uintmax_t>(bytes, uintmax_t(1) << 40));
+  const sf_count_t reserve = std::min(info.frames, std::max(kChunkFrames, size_bound));
+  out.channels.assign(nc, {});
+  for (auto& ch : out.channels) ch.reserve(static_cast<size_t>(reserve));
 
   std::vector<float> interleaved(static_cast<size_t>(std::min(info.frames, kChunkFrames)) * nc);
   sf_count_t done = 0;
-  while (done < info.frames) {
-    const sf_count_t want = std::min(kChunkFrames, info.frames - done);
+  while (!length_known || done < info.frames) {
+    const sf_count_t want =
+        length_known ? std::min(kChunkFrames, info.frames - done) : kChunkFrames;
     const sf_count_t got = sf_readf_float(file.get(), interleaved.data(), want);
     if (got <= 0) break;
-    for (sf_count_t i = 0; i < got; ++i) {
-      for (int c = 0; c < nc; ++c) out.channels[c][done + i] = interleaved[size_t(i) * nc + c];
+    for (int c = 0; c < nc; ++c) {
+      std::vector<float>& ch = out.channels[c];
+      for (sf_count_t i = 0; i < got; ++i) ch.push_back(interleaved[size_t(i) * nc + c]);
     }
     done += got;
   }
-  if (done < info.frames) {
+  require(length_known || done > 0,
+          path + ": the audio file is empty (0 frames could be read); expected a recording");
+  if (length_known && done < info.frames) {
     throw Error(path + ": truncated audio file (header announces " + std::to_string(info.frames) +
                 " frames, only " + std::to_string(done) +
                 " could be read); re-export or re-copy it");

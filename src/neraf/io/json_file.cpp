@@ -11,6 +11,8 @@ nlohmann::json read_json(const std::string& path) {
     return nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     throw Error(path + ": not valid JSON (at byte " + std::to_string(e.byte) + "); fix or regenerate the file");
+  } catch (const nlohmann::json::exception& e) {  // e.g. out_of_range: a number beyond a double
+    throw Error(path + ": not valid JSON (" + e.what() + "); fix or regenerate the file");
   }
 }
 

@@ -127,6 +127,20 @@ NpyHeader read_npy_header(const std::string& path) {
                                   "numpy.save(path, np.ascontiguousarray(arr))");
   h.shape = parse_shape(path, shape_text);
   h.data_offset = prefix + header_len;
+  // The element count is checked before it is multiplied out: a hostile shape must not overflow
+  // (and wrap around to a size the file seems to hold). The zero sizes are left out, so that no
+  // partial product of num_elements() can overflow either.
+  {
+    const int64_t max_bytes = std::numeric_limits<int64_t>::max() - h.data_offset;
+    int64_t n = 1;
+    for (const int64_t d : h.shape) {
+      if (d == 0) continue;
+      require(n <= max_bytes / h.element_size / d,
+              path + ": .npy shape " + shape_text +
+                  " is too large for any array; the file is damaged, re-create it");
+      n *= d;
+    }
+  }
 
   in.seekg(0, std::ios::end);
   const int64_t file_size = static_cast<int64_t>(in.tellg());

@@ -47,9 +47,9 @@ bool detect_amx() {
 
 // One 2×2 (or 1×2 for a last odd row block) block of result tiles over the whole depth.
 __attribute__((target("amx-tile,amx-bf16"))) void amx_kernel(const uint16_t* x, int row_blocks,
-                                                              int k_blocks, const uint16_t* w,
-                                                              int n_padded, float* y,
-                                                              int jb_begin, int jb_end) {
+                                                             int k_blocks, const uint16_t* w,
+                                                             int n_padded, float* y, int jb_begin,
+                                                             int jb_end) {
   constexpr size_t kTile = 512;  // bf16 values per tile
   const long y_stride = long(n_padded) * 4;
   for (int ib = 0; ib < row_blocks; ib += 2) {
@@ -92,6 +92,9 @@ __attribute__((target("amx-tile"))) void load_tile_config() {
     cfg.rows[t] = kAmxRows;
     cfg.colsb[t] = 64;
   }
+  // GCC 12 does not model ldtilecfg's read of `cfg`: without this barrier it drops the stores
+  // above as dead (seen without -march=native), and the garbage configuration faults.
+  __asm__ volatile("" : : "r"(&cfg) : "memory");
   _tile_loadconfig(&cfg);
 }
 
@@ -152,7 +155,8 @@ void pack_activations(const float* x, int rows, int cols, size_t ld, int m_padde
           for (int c = 0; c < kAmxDepth; ++c) dst[c] = float_to_bf16(src[c]);
         } else {
           for (int c = 0; c < kAmxDepth; ++c)
-            dst[c] = (row < rows && col0 + c < cols) ? float_to_bf16(x[size_t(row) * ld + col0 + c]) : 0;
+            dst[c] =
+                (row < rows && col0 + c < cols) ? float_to_bf16(x[size_t(row) * ld + col0 + c]) : 0;
         }
       }
     }

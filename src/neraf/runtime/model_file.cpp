@@ -330,6 +330,10 @@ void check_config(const ModelData& m, const std::string& name) {
                            std::to_string(m.n_fft / 2 + 1));
   check_range(m.max_len, 2, 1 << 16, "max_len (frames)", name);
   check_range(m.waveform_length, 0, int64_t(1) << 26, "waveform_length", name);
+  // The implicit length hop·(T − 1) gets the same bound: the RIR length sizes Griffin-Lim's
+  // buffers at load, and neraf_model_info holds it in an int.
+  check_range(m.rir_length(), 1, int64_t(1) << 26,
+              "the RIR length (waveform_length, or hop_length·(max_len − 1))", name);
   if (!satisfies_nola(padded_hann_window(m.n_fft, m.win_length), m.hop_length))
     format_error(name, "hop_length " + std::to_string(m.hop_length) +
                            " leaves gaps between the Hann windows of " +

@@ -6,7 +6,8 @@
 //   exp_approx   relative error < 1e-7 on [−87, 88] (Cephes expf)
 //   log_approx   absolute error < 6e-7 for normal x > 0, up to 1e5 (Cephes logf)
 //   tanh_approx  absolute error < 1.5e-7 (a rational fit below 0.625, 1 − 2/(e^{2|x|} + 1) above)
-// Inputs outside those domains (NaN, x ≤ 0 for log) give unspecified values, never traps.
+// exp_approx and tanh_approx give NaN for NaN; other inputs outside those domains (NaN or x ≤ 0
+// for log) give unspecified values, never traps.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -27,8 +28,11 @@ inline uint32_t float_to_bits(float f) {
 inline float exp_approx(float x) {
   x = x < -87.0f ? -87.0f : (x > 88.0f ? 88.0f : x);
   // n = floor(x·log2(e) + 1/2), so x = n·ln2 + r with |r| ≤ ln2/2. (Truncation of a value made
-  // positive: std::floor keeps the loop from vectorising.)
-  const float n = float(int32_t(x * 1.44269504088896341f + 128.5f)) - 128.0f;
+  // positive: std::floor keeps the loop from vectorising.) The clamps let a NaN through, and
+  // converting a NaN to int is undefined behaviour: n is taken from xn, which is x except that a
+  // NaN becomes −87 (and still comes out NaN through r). This form GCC still vectorises.
+  const float xn = x > -87.0f ? x : -87.0f;
+  const float n = float(int32_t(xn * 1.44269504088896341f + 128.5f)) - 128.0f;
   const float r = (x - n * 0.693359375f) - n * -2.12194440e-4f;  // ln2 in two parts: exact n·C1
   float p = 1.9875691500e-4f;
   p = p * r + 1.3981999507e-3f;

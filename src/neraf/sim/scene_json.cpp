@@ -456,6 +456,16 @@ void validate_scene(const Scene& s, const std::string& origin) {
         fail(c, p + ".wall_margin_m",
              "a margin of " + fmt(g.wall_margin_m) + " m leaves no floor area in a " +
                  fmt(s.size.x) + " x " + fmt(s.size.z) + " m room; reduce it");
+      // The grid's size from grid_microphone_positions' formula, before any point is made: a tiny
+      // spacing (or a huge room) must be this error, not billions of points or an int overflow.
+      const auto axis_count = [&](double length) {
+        const double usable = length - 2 * g.wall_margin_m;
+        return usable < 0 ? 0.0 : std::floor(usable / g.spacing_m + 1e-9) + 1;
+      };
+      const double grid_count = axis_count(s.size.x) * axis_count(s.size.z);
+      if (grid_count > 1000000)
+        fail(c, p + ".spacing_m",
+             "gives " + fmt(grid_count) + " grid points; use a larger spacing");
       const auto points = grid_microphone_positions(s);
       if (points.empty())
         fail(c, p,
