@@ -93,6 +93,9 @@ expect_exit 0 "$NERAF" export --run "$R" --out "$TMP/m16.nrf" --precision bf16
 [ "$(stat -c %s "$TMP/m16.nrf")" -lt "$(stat -c %s "$M")" ] || fail "bf16 export is not smaller"
 expect_exit 0 "$NERAF" eval --run "$R" --json "$TMP/e_run.json" --skip-vision --max-rirs 4 --no-images --quiet
 expect_exit 0 "$NERAF" eval --model "$M" --json "$TMP/e_model.json" --max-rirs 4 --no-images --quiet
+expect_exit 0 "$NERAF" eval --run "$R" --json "$TMP/e_bf16.json" --skip-vision --max-rirs 2 --no-images --quiet --precision bf16
+expect_in "$TMP/e_bf16.json" '"precision": "bf16"'
+expect_exit 2 "$NERAF" render rir --model "$M" --mic "$MIC" --src "$SRC" --precision bf16 --out "$TMP/x.wav"
 python3 - "$TMP/e_run.json" "$TMP/e_model.json" <<'PY' || fail "eval --model differs from eval --run"
 import json, sys
 a, b = (json.load(open(p))["audio"] for p in sys.argv[1:])

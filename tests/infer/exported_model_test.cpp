@@ -105,6 +105,24 @@ TEST(ExportedModel, SampledGridFoldedIntoTheBiasMatchesLibTorch) {
 
 TEST(ExportedModel, NoGridMatchesLibTorch) { expect_same_predictions("none"); }
 
+// Queries are fp32 by default whatever trained the run (the tiny config trains in fp32 here);
+// bf16 on request rounds the trunk's products: close to, not equal to, fp32.
+TEST(AudioRunPrecision, Bf16IsTheCallersChoice) {
+  const std::string dir = make_temp_dir("precision");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  const std::string run_dir = make_run(dir, rirs, tiny_joint_config());
+  const AudioRun fp32 = load_audio_run(run_dir);
+  const AudioRun bf16 = load_audio_run(run_dir, torch::kCPU, "", nerf::Precision::bf16);
+  EXPECT_FALSE(fp32.model()->options().nacf.bf16);
+  EXPECT_TRUE(bf16.model()->options().nacf.bf16);
+  const Poses p = poses_of(rirs);
+  const torch::Tensor a = fp32.predict_log_stft_batch(p.mic, p.src, p.yaw);
+  const torch::Tensor b = bf16.predict_log_stft_batch(p.mic, p.src, p.yaw);
+  const double diff = (a - b).abs().max().item<double>();
+  EXPECT_GT(diff, 0.0);
+  EXPECT_LT(diff, 0.1);
+}
+
 TEST(ExportedModel, DamagedFilesAreOneClearError) {
   const std::string dir = make_temp_dir("export_bad");
   const data::RirSet rirs = tiny_rir_set(dir);

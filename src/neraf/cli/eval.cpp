@@ -35,6 +35,7 @@ struct EvalArgs {
   std::string images;
   std::string data;
   std::string checkpoint;
+  std::string precision = "fp32";  // of the acoustic fields of --run and --ablation-runs
   int64_t max_views = -1;
   int threads = 0;
   bool no_images = false;
@@ -141,7 +142,8 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
   infer::check_audio_manifest(source.manifest.at("audio"), rirs, data_dir);
   std::vector<std::pair<std::string, infer::AudioRun>> ablations;
   for (const std::string& dir : split_commas(args.ablation_runs)) {
-    ablations.emplace_back(dir, infer::load_audio_run(dir, torch::kCPU));
+    ablations.emplace_back(
+        dir, infer::load_audio_run(dir, torch::kCPU, "", nerf::parse_precision(args.precision)));
     infer::check_audio_manifest(ablations.back().second.run().manifest.at("audio"), rirs,
                                 dir + "/data.json");
   }
@@ -247,6 +249,11 @@ void register_eval(CLI::App& app) {
   cmd->add_option("--checkpoint", args->checkpoint,
                   "A specific checkpoint file (default: the run's latest)")
       ->needs(run_opt);
+  cmd->add_option("--precision", args->precision,
+                  "Audio: arithmetic of the acoustic fields of --run and --ablation-runs: fp32 "
+                  "(default, whatever trained them) or bf16 (as a bf16 run trained)")
+      ->check(CLI::IsMember({"fp32", "bf16"}))
+      ->needs(run_opt);
   cmd->add_option("--max-views", args->max_views, "Evaluate only the first N eval views")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", args->threads, "CPU threads (default: all cores)")
@@ -296,9 +303,11 @@ void register_eval(CLI::App& app) {
         infer::train_config_from_json(io::read_json(config_path), config_path);
     nlohmann::json out = {{"run", args->run}};
     if (cfg.modality != infer::Modality::vision) {
-      const infer::AudioRun audio = infer::load_audio_run(args->run, torch::kCPU, args->checkpoint);
+      const infer::AudioRun audio = infer::load_audio_run(args->run, torch::kCPU, args->checkpoint,
+                                                          nerf::parse_precision(args->precision));
       out["checkpoint"] = audio.run().checkpoint;
       out["step"] = audio.step();
+      out["precision"] = args->precision;
       const EvalField source{audio,
                              audio.run().manifest,
                              audio.run().config.seed,

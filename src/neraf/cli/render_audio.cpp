@@ -348,6 +348,11 @@ void add_field_options(CLI::App* cmd, FieldArgs& a, bool poses) {
   cmd->add_option("--checkpoint", a.checkpoint,
                   "A specific checkpoint file of --run (default: the run's latest)")
       ->needs(a.run_opt);
+  cmd->add_option("--precision", a.precision,
+                  "Arithmetic of --run's acoustic field: fp32 (default, whatever trained the run) "
+                  "or bf16 (as a bf16 run trained)")
+      ->check(CLI::IsMember({"fp32", "bf16"}))
+      ->needs(a.run_opt);
   if (poses) {
     cmd->add_flag("--allow-outside", a.allow_outside,
                   "Render poses outside the field's training box (train microphones +- 1 m) "
@@ -366,8 +371,8 @@ LoadedField load_field(const FieldArgs& a) {
     return out;
   }
   if (a.run.empty()) throw CLI::RequiredError("--run or --model");
-  auto run =
-      std::make_unique<infer::AudioRun>(infer::load_audio_run(a.run, torch::kCPU, a.checkpoint));
+  auto run = std::make_unique<infer::AudioRun>(infer::load_audio_run(
+      a.run, torch::kCPU, a.checkpoint, nerf::parse_precision(a.precision, "--precision")));
   out.step = run->step();
   out.name = a.run;
   out.field = std::move(run);

@@ -23,12 +23,14 @@ struct FieldArgs {
   std::string run;
   std::string model;
   std::string checkpoint;
+  std::string precision = "fp32";  // of --run's queries
   bool allow_outside = false;
   CLI::Option* run_opt = nullptr;
   CLI::Option* model_opt = nullptr;
 };
 
-// --run, --model (exclusive; load_field requires one), --checkpoint (needs --run) and, when
+// --run, --model (exclusive; load_field requires one), --checkpoint and --precision (need --run)
+// and, when
 // `poses` (the command checks poses against the training box), --allow-outside.
 void add_field_options(CLI::App* cmd, FieldArgs& args, bool poses);
 

@@ -171,7 +171,7 @@ torch::Tensor AudioRun::predict_log_stft_batch(const torch::Tensor& mic, const t
 }
 
 AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
-                        const std::string& checkpoint) {
+                        const std::string& checkpoint, nerf::Precision precision) {
   std::error_code ec;
   const std::string config_path = (fs::path(run_dir) / "config.json").string();
   const std::string manifest_path = (fs::path(run_dir) / "data.json").string();
@@ -201,9 +201,9 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
   const AudioRunInfo& info = out.info_;
   acoustic::AcousticModelOptions opts =
       audio_model_options(out.run_.config, info.channels, info.n_freq, info.max_len, info.aabb);
-  // Queries run in fp32 whatever trained the run (bf16 training keeps fp32 master weights): the
-  // numbers of eval and render do not depend on the machine, and match an fp32 export.
-  opts.nacf.bf16 = false;
+  // Queries run in fp32 unless asked (bf16 training keeps fp32 master weights): the numbers of
+  // eval and render then do not depend on the machine, and match an fp32 export.
+  opts.nacf.bf16 = precision == nerf::Precision::bf16;
   out.model_ = acoustic::AcousticModel(opts);
   acoustic::GridSampler grid(opts.grid);
   torch::serialize::InputArchive a;

@@ -15,7 +15,8 @@
 // RAF), encoded as ((cos+1)/2, 0.5, (sin+1)/2). Positions outside the train audio aabb are zeroed
 // (the reference's rule) — the prediction is then meaningless; check info().aabb.
 // Batch many poses with predict_log_stft_batch (one NAcF call per pose, the scene feature is
-// computed once at load). Queries run NAcF in fp32 whatever precision trained the run.
+// computed once at load). Queries run NAcF in fp32 whatever precision trained the run (unless
+// load_audio_run is asked for bf16).
 //
 // Threads: every query is const and may run from several threads at once on one AudioRun. The
 // model is put in eval mode once, at load; a query runs NAcF on the scene feature computed then
@@ -36,6 +37,7 @@
 #include "neraf/geometry/vec.h"
 #include "neraf/infer/audio_field.h"
 #include "neraf/infer/run.h"
+#include "neraf/nerf/config.h"
 
 namespace neraf::infer {
 
@@ -87,7 +89,8 @@ class AudioRun final : public AudioField {
   const torch::Tensor& calibration() const { return calibration_; }
 
  private:
-  friend AudioRun load_audio_run(const std::string&, torch::Device, const std::string&);
+  friend AudioRun load_audio_run(const std::string&, torch::Device, const std::string&,
+                                 nerf::Precision);
   LoadedRun run_;  // run_.model is the radiance field (nullptr-free only for vision/joint runs)
   AudioRunInfo info_;
   acoustic::AcousticModel model_{nullptr};  // eval mode from load on; queries only read it
@@ -95,9 +98,12 @@ class AudioRun final : public AudioField {
   torch::Tensor calibration_;  // [C, F, T] energy gains (acoustic/calibration.h) or undefined
 };
 
-// Loads RUN (latest checkpoint, or `checkpoint`) with its acoustic field. neraf::Error when the
-// run has no acoustic branch (modality vision) or is broken.
+// Loads RUN (latest checkpoint, or `checkpoint`) with its acoustic field. Queries run NAcF's
+// trunk in `precision` (fp32 by default, whatever trained the run; bf16: as a bf16 run trained,
+// on machines with native bf16). neraf::Error when the run has no acoustic branch (modality
+// vision) or is broken.
 AudioRun load_audio_run(const std::string& run_dir, torch::Device device = torch::kCPU,
-                        const std::string& checkpoint = "");
+                        const std::string& checkpoint = "",
+                        nerf::Precision precision = nerf::Precision::fp32);
 
 }  // namespace neraf::infer
