@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "neraf/dsp/auralize.h"
 #include "neraf/geometry/trajectory.h"
 #include "neraf/infer/audio_run.h"
 #include "neraf/infer/exported_model.h"
@@ -142,9 +143,7 @@ void render_pose_list(const LoadedField& field, const FieldArgs& field_args,
           render::render_rir(bind(*field.field), model_info(info), p.mic, p.source, p.yaw_deg, o);
       const std::string file = p.name + ".wav";
       io::write_audio((tmp / file).string(), rir);
-      float peak = 0;
-      for (const auto& ch : rir.channels)
-        for (float x : ch) peak = std::max(peak, std::abs(x));
+      const float peak = dsp::peak_abs(rir);
       char row[512];
       std::snprintf(row, sizeof row, "%s,%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d,%d,%.6g,%.6g\n",
                     p.name.c_str(), file.c_str(), p.mic.x, p.mic.y, p.mic.z, p.source.x, p.source.y,

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "neraf/cli/render_audio.h"
+#include "neraf/dsp/auralize.h"
 #include "neraf/dsp/resample.h"
 #include "neraf/geometry/trajectory.h"
 #include "neraf/infer/run.h"
@@ -180,13 +181,9 @@ void run_trajectory(const TrajectoryArgs& args) {
   result.sample_rate = sr;
   result.channels = std::move(wet);
   for (auto& ch : result.channels) ch.resize(out_length);
-  float peak = 0;
-  for (const auto& ch : result.channels)
-    for (float x : ch) peak = std::max(peak, std::abs(x));
-  if (args.normalize && peak > 0) {
-    for (auto& ch : result.channels)
-      for (float& x : ch) x *= 0.99f / peak;
-  } else if (peak > 1.0f) {
+  if (args.normalize) {
+    dsp::normalize_peak(result, 0.99f);
+  } else if (dsp::peak_abs(result) > 1.0f) {
     warn(args.out +
          ": peak above full scale; the float WAV keeps it, but playback will clip; "
          "pass --normalize");
