@@ -45,6 +45,7 @@ set_target_properties(neraf_rt PROPERTIES EXCLUDE_FROM_ALL ON)
 # What each target links: the stage its parser lives in (and only that).
 set(neraf_fuzz_libs_audio_file neraf_io)
 set(neraf_fuzz_libs_npy neraf_io)
+set(neraf_fuzz_libs_sealed_file neraf_io)
 set(neraf_fuzz_libs_json_file neraf_io)
 set(neraf_fuzz_libs_trajectory neraf_geometry)
 set(neraf_fuzz_libs_trajectory_file neraf_geometry)

@@ -249,11 +249,16 @@ TEST(ImageSet, RafSizedFractionSplitCounts) {
     NerfstudioScene scene;
     scene.names = {"images/frame_00000.png"};
     scene.write(dir.path());
+    // One file per frame: the same image listed twice is an error (a duplicate frame).
     std::string frames;
-    for (int i = 0; i < n; ++i)
-      frames += std::string(i ? "," : "") +
-                R"({"file_path": "images/frame_00000.png", "transform_matrix": [[1,0,0,)" +
-                std::to_string(i) + "],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}";
+    for (int i = 0; i < n; ++i) {
+      char name[64];
+      std::snprintf(name, sizeof name, "images/frame_%05d.png", i);
+      if (i > 0) fs::copy_file(dir / "images/frame_00000.png", dir / name);
+      frames += std::string(i ? "," : "") + R"({"file_path": ")" + name +
+                R"(", "transform_matrix": [[1,0,0,)" + std::to_string(i) +
+                "],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}";
+    }
     testing::write_text(
         dir / "transforms.json",
         R"({"fl_x": 10, "fl_y": 10, "cx": 6, "cy": 4, "w": 12, "h": 8, "frames": [)" + frames +

@@ -137,7 +137,7 @@ TEST(Validate, NaNPoses) {
   expect_one_error(raf.path(), "data/000001/tx_pos.txt", "NaN");
   room.write(raf.path());
   testing::write_text(raf / "data/000004/rx_pos.txt", "1.0,inf,2.0\n");
-  expect_one_error(raf.path(), "data/000004/rx_pos.txt", "NaN or infinite");
+  expect_one_error(raf.path(), "data/000004/rx_pos.txt", "NaN, infinite");
   room.write(raf.path());
   testing::write_text(raf / "data/000004/tx_pos.txt", "0,0,0,0,1,1.5,1.0\n");
   expect_one_error(raf.path(), "data/000004/tx_pos.txt", "zero quaternion");
@@ -192,7 +192,8 @@ TEST(Validate, ImageSizeDiffersFromIntrinsics) {
 TEST(Validate, UnreadableAudioAndBadMagnitudeFile) {
   SoundSpacesWithImages ss;
   testing::write_text(ss.audio.wav(ss.dir.path(), ss.audio.entries[4]), "this is not audio");
-  expect_one_error(ss.dir.path(), "binaural_rirs/0/2_1.wav", "not a readable audio file");
+  expect_one_error(ss.dir.path(), "binaural_rirs/0/2_1.wav",
+                   "not an audio file libsndfile can read");
 
   SoundSpacesWithImages ss2;
   for (size_t i = 0; i < ss2.audio.entries.size(); ++i) {

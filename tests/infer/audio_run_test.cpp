@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "audio_test_util.h"
+#include "neraf/infer/calibration.h"
 #include "neraf/infer/checkpoint.h"
 #include "neraf/io/json_file.h"
 #include "neraf/train/trainer.h"
@@ -61,8 +62,24 @@ TEST(AudioRun, ConcurrentQueriesMatchSequentialOnes) {
   }
   io::write_json_atomically(run_dir + "/config.json", to_json(c));
   io::write_json_atomically(run_dir + "/data.json", {{"audio", make_audio_manifest(rirs)}});
+  EXPECT_FALSE(load_audio_run(run_dir).calibration().defined());  // saving does not calibrate
+  calibrate_run(run_dir, rirs);  // the stage training ends with
   const AudioRun run = load_audio_run(run_dir);
   ASSERT_TRUE(run.calibration().defined());  // the cpu preset's energy calibration is applied
+  EXPECT_FALSE(load_audio_run(run_dir, torch::kCPU, "", nerf::Precision::fp32, false)
+                   .calibration()
+                   .defined());
+  // A calibration fitted for another step is refused, naming the file.
+  save_calibration(checkpoint_path(run_dir, 1), 5, run.calibration());
+  try {
+    load_audio_run(run_dir);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("step-000000001.calibration.pt: fitted for another step"),
+              std::string::npos)
+        << e.what();
+  }
+  save_calibration(checkpoint_path(run_dir, 1), 1, run.calibration());
   EXPECT_FALSE(run.model()->is_training());
 
   const size_t n = rirs.rirs.size();

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "audio_test_util.h"
+#include "neraf/infer/calibration.h"
 #include "neraf/infer/checkpoint.h"
 #include "neraf/io/json_file.h"
 #include "neraf/train/trainer.h"
@@ -39,6 +40,7 @@ std::string make_run(const std::string& dir, const data::RirSet& rirs, const Tra
   io::write_json_atomically(run_dir + "/config.json", to_json(c));
   io::write_json_atomically(run_dir + "/data.json",
                             {{"data", rirs.root}, {"audio", make_audio_manifest(rirs)}});
+  calibrate_run(run_dir, rirs);  // the stage training ends with
   return run_dir;
 }
 

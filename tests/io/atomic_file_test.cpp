@@ -2,11 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <stdexcept>
 
+#include "neraf/io/folder_lock.h"
 #include "neraf/io/json_file.h"
 #include "neraf/util/error.h"
 
@@ -84,6 +87,98 @@ TEST_F(AtomicFileTest, JsonNumberOverflowIsAnErrorNamingTheFile) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("huge.json: not valid JSON"), std::string::npos);
   }
+}
+
+TEST_F(AtomicFileTest, RefusesToReplaceAnythingButARegularFile) {
+  fs::create_directories(dir_);
+  const fs::path real = dir_ / "real.txt";
+  write_text_atomically(real.string(), "keep");
+  const fs::path link = dir_ / "link.txt";
+  fs::create_symlink(real, link);
+  const fs::path fifo = dir_ / "fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
+  for (const auto& [path, kind] : {std::pair{link, "symbolic link"}, std::pair{fifo, "FIFO"},
+                                   std::pair{dir_, "folder"}}) {
+    try {
+      write_text_atomically(path.string(), "new");
+      FAIL() << path;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(kind), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_TRUE(fs::is_symlink(link));
+  EXPECT_EQ(fs::status(fifo).type(), fs::file_type::fifo);
+  EXPECT_EQ(read_text_file(real.string()), "keep");
+  try {
+    write_text_atomically("/dev/null", "x");  // as root this would replace the device node
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/null: exists and is a device"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST_F(AtomicFileTest, FolderIsBuiltBesideAndRenamedIntoPlace) {
+  const fs::path out = dir_ / "set";
+  write_folder_atomically(out.string(), [&](const std::string& tmp) {
+    EXPECT_FALSE(fs::exists(out));  // nothing at the target while it is being built
+    EXPECT_EQ(fs::path(tmp).parent_path(), dir_);
+    write_text_atomically(tmp + "/a.txt", "a");
+  });
+  EXPECT_EQ(read_text_file((out / "a.txt").string()), "a");
+  EXPECT_TRUE(only_file_is(out));
+  // A failure leaves the old folder as it was and no temporary folder.
+  EXPECT_THROW(write_folder_atomically(
+                   out.string(),
+                   [](const std::string& tmp) {
+                     write_text_atomically(tmp + "/b.txt", "half");
+                     throw std::runtime_error("disk full");
+                   },
+                   /*replace=*/true),
+               std::runtime_error);
+  EXPECT_EQ(read_text_file((out / "a.txt").string()), "a");
+  EXPECT_TRUE(only_file_is(out));
+  // Without `replace` a non-empty folder is refused; with it, it is swapped.
+  EXPECT_THROW(write_folder_atomically(out.string(), [](const std::string&) {}), Error);
+  write_folder_atomically(
+      out.string(), [](const std::string& tmp) { write_text_atomically(tmp + "/c.txt", "c"); },
+      /*replace=*/true);
+  EXPECT_FALSE(fs::exists(out / "a.txt"));
+  EXPECT_EQ(read_text_file((out / "c.txt").string()), "c");
+  EXPECT_TRUE(only_file_is(out));
+}
+
+TEST_F(AtomicFileTest, StaleTemporariesOfDeadProcessesAreRemoved) {
+  fs::create_directories(dir_);
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ASSERT_GT(child, 0);
+  ::waitpid(child, nullptr, 0);  // a PID that no process has now
+  const std::string dead = std::to_string(child), alive = std::to_string(::getppid());
+  write_text_atomically((dir_ / ("ckpt.pt.tmp-" + dead)).string(), "left by a kill");
+  fs::create_directory(dir_ / (".set.tmp-" + dead));
+  write_text_atomically((dir_ / ("model.nrf.tmp-" + dead + ".tmp-Ab12Cd")).string(), "x");
+  write_text_atomically((dir_ / ("other.tmp-" + alive)).string(), "a live writer's");
+  write_text_atomically((dir_ / "plain.txt").string(), "data");
+  EXPECT_EQ(remove_stale_temporaries(dir_.string()), 3);
+  EXPECT_TRUE(fs::exists(dir_ / ("other.tmp-" + alive)));
+  EXPECT_TRUE(fs::exists(dir_ / "plain.txt"));
+  EXPECT_EQ(remove_stale_temporaries(dir_.string()), 0);
+}
+
+TEST_F(AtomicFileTest, FolderLockRefusesASecondWriterAndNamesThePid) {
+  {
+    const FolderLock first(dir_.string());
+    try {
+      const FolderLock second(dir_.string());
+      FAIL();
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("PID " + std::to_string(::getpid())),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_NO_THROW(FolderLock again(dir_.string()));  // released with the first
 }
 
 TEST_F(AtomicFileTest, JsonRoundTrip) {

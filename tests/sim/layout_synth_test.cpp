@@ -310,10 +310,29 @@ TEST(LayoutSynth, RefusesANonEmptyFolderUnlessForced) {
   forced.force = true;
   EXPECT_NO_THROW(synthesize(scene, forced));
   EXPECT_TRUE(fs::exists(out / "data/000000/rir.wav"));
-  EXPECT_EQ(io::read_text_file((out / "notes.txt").string()), "keep me");
-  // No temporary files are left behind.
+  EXPECT_FALSE(fs::exists(out / "notes.txt"));  // --force replaces the folder as a whole
+  // No temporary files or folders are left behind, beside it or in it.
   for (const auto& e : fs::recursive_directory_iterator(out))
     EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos) << e.path();
+  for (const auto& e : fs::directory_iterator(out.parent_path()))
+    EXPECT_EQ(e.path().filename().string().find("." + out.filename().string() + ".tmp-"),
+              std::string::npos)
+        << e.path();
+  // A synthesis that fails half-way (a bad HRTF file, after the pictures) leaves the old dataset
+  // as it was, and nothing in a new folder.
+  const fs::path bad_hrtf = out.parent_path() / "not_a_sofa.sofa";
+  io::write_text_atomically(bad_hrtf.string(), "not HDF5");
+  Scene binaural = scene;
+  SynthOptions failing = options(out, 1, "soundspaces");
+  failing.force = true;
+  failing.hrtf_path = bad_hrtf.string();
+  EXPECT_THROW(synthesize(binaural, failing), Error);
+  EXPECT_TRUE(fs::exists(out / "data/000000/rir.wav"));
+  const fs::path fresh = temp_dir("fails_fresh");
+  failing.out_dir = fresh.string();
+  EXPECT_THROW(synthesize(binaural, failing), Error);
+  EXPECT_FALSE(fs::exists(fresh) && !fs::is_empty(fresh));
+  fs::remove(bad_hrtf);
   EXPECT_THROW(synthesize(scene, options(temp_dir("bad_layout"), 1, "nerf")), Error);
   fs::remove_all(out);
 }

@@ -7,7 +7,9 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <cmath>
 #include <fstream>
+#include <limits>
 
 #include "../infer/synthetic_scene.h"
 #include "neraf/train/lr_schedule.h"
@@ -101,11 +103,64 @@ TEST(Checkpoint, CorruptedOrTruncatedFileIsAClearError) {
       EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
     }
   }
-  // Bit flips inside the zip: either detected (CRC) as a neraf::Error, never a crash.
+  // Bytes changed anywhere (here in the tensors' data) fail the checksum.
   auto u = make_trainer(cfg, &images, torch::kCPU);
   try {
     u->load_checkpoint(d.file("flipped.pt"));
-  } catch (const neraf::Error&) {
+    FAIL();
+  } catch (const neraf::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("flipped.pt: damaged (checksum"), std::string::npos)
+        << e.what();
+  }
+}
+
+namespace {
+// One parameter and one loss that is NaN or infinite on demand.
+class DivergingBranch : public Branch {
+ public:
+  explicit DivergingBranch(double factor) : factor_(factor) {}
+  std::string name() const override { return "diverging"; }
+  std::vector<ParamGroup> param_groups() override {
+    neraf::infer::ScheduleConfig schedule;
+    schedule.lr = 0.1;
+    return {{"fields", {weight_}, schedule}};
+  }
+  LossDict losses(StepContext&) override { return {{"bad_loss", weight_.sum() * factor_}}; }
+  void set_training(bool) override {}
+  void save(torch::serialize::OutputArchive&) override {}
+  void load(torch::serialize::InputArchive&, const std::string&) override {}
+  torch::Tensor weight_ = torch::ones({4}).set_requires_grad(true);
+
+ private:
+  double factor_;
+};
+}  // namespace
+
+TEST(Trainer, ANonFiniteLossStopsBeforeTheStepAndNamesTheTerm) {
+  TempDir d;
+  for (const double factor : {std::nan(""), std::numeric_limits<double>::infinity()}) {
+    Trainer t(fixtures::tiny_train_config(), torch::kCPU);
+    auto branch = std::make_unique<DivergingBranch>(factor);
+    DivergingBranch* b = branch.get();
+    t.add_branch(std::move(branch));
+    try {
+      t.step();
+      FAIL();
+    } catch (const DivergedError& e) {
+      EXPECT_NE(std::string(e.what()).find(std::string("step 1: the loss term 'bad_loss' is ") +
+                                           (std::isnan(factor) ? "NaN" : "infinite")),
+                std::string::npos)
+          << e.what();
+    }
+    EXPECT_TRUE(torch::equal(b->weight_, torch::ones({4})));  // not applied
+    EXPECT_EQ(t.completed_steps(), 0);
+    // Non-finite weights are never saved.
+    {
+      torch::NoGradGuard no_grad;
+      b->weight_[0] = std::nan("");
+    }
+    EXPECT_THROW(t.save_checkpoint(d.file("nan.pt")), DivergedError);
+    EXPECT_FALSE(fs::exists(d.file("nan.pt")));
   }
 }
 

@@ -12,6 +12,7 @@
 #include "neraf/eval/evaluation.h"
 #include "neraf/infer/checkpoint.h"
 #include "neraf/infer/image_output.h"
+#include "neraf/io/folder_lock.h"
 #include "neraf/io/json_file.h"
 #include "neraf/train/run_training.h"
 #include "neraf/util/error.h"
@@ -134,4 +135,49 @@ TEST(Run, TrainResumeRefuseAndLoad) {
   const TrainRunSummary s4 = run_training(cfg, f);
   EXPECT_EQ(s4.start_step, 0);
   EXPECT_FALSE(fs::exists(checkpoint_path(run.string(), 7)));
+}
+
+TEST(Run, KeepsTheNewestRefusesASecondWriterAndSkipsDamagedCheckpoints) {
+  TempDir tmp("keep");
+  const fs::path data = tmp.path / "data", run = tmp.path / "run";
+  write_dataset(data, fixtures::make_image_set(3, 12));
+  TrainConfig cfg = fixtures::tiny_train_config();
+  cfg.steps = 6;
+  cfg.fields.max_steps = cfg.proposal_networks.max_steps = 6;
+  cfg.save_every = 1;
+  TrainRunOptions o;
+  o.data_dir = data.string();
+  o.run_dir = run.string();
+  o.progress = false;
+  o.keep = 2;
+  run_training(cfg, o);
+  EXPECT_EQ(checkpoints_newest_first(run.string()),
+            (std::vector<std::string>{checkpoint_path(run.string(), 6),
+                                      checkpoint_path(run.string(), 5)}));
+
+  TrainRunOptions r = o;
+  r.resume = true;
+  r.steps = 8;
+  {
+    const neraf::io::FolderLock other_writer(run.string());
+    try {
+      run_training(cfg, r);
+      FAIL();
+    } catch (const neraf::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("another neraf process (PID"), std::string::npos)
+          << e.what();
+    }
+  }
+  // The newest checkpoint damaged (a changed byte): resume falls back to the one before.
+  const std::string newest = checkpoint_path(run.string(), 6);
+  {
+    std::fstream f(newest, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>(fs::file_size(newest) / 2));
+    f.put('\x7f');
+  }
+  EXPECT_NE(checkpoint_damage(newest).find("checksum"), std::string::npos);
+  const TrainRunSummary s = run_training(cfg, r);
+  EXPECT_EQ(s.start_step, 5);
+  EXPECT_EQ(s.end_step, 8);
+  EXPECT_EQ(checkpoint_damage(checkpoint_path(run.string(), 8)), "");
 }

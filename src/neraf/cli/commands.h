@@ -14,5 +14,6 @@ void register_eval(CLI::App& app);
 void register_info(CLI::App& app);
 void register_synth(CLI::App& app);
 void register_export(CLI::App& app);
+void register_calibrate(CLI::App& app);
 
 }  // namespace neraf::cli

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "neraf/cli/commands.h"
+#include "neraf/cli/flag_checks.h"
 #include "neraf/data/image_set.h"
 #include "neraf/eval/audio_eval.h"
 #include "neraf/eval/evaluation.h"
@@ -45,6 +46,11 @@ struct EvalArgs {
   int64_t max_rirs = -1;
   std::string ablation_runs;  // comma-separated run folders (e.g. trained with --grid none/zeros)
   std::string novel_data;     // another dataset of the same room: every RIR is scored
+  // The audio feature cache; unset: what the run's config.json records (the default folder and
+  // fp32 for an exported model).
+  std::string cache_dir;
+  std::string cache_precision;
+  CLI::Option* cache_dir_opt = nullptr;
 };
 
 std::vector<std::string> split_commas(const std::string& s) {
@@ -103,9 +109,17 @@ nlohmann::json score_audio(const infer::AudioField& run,
   return out;
 }
 
-data::RirSet load_rirs(const std::string& dir, bool progress) {
+// The cache settings eval reads the RIR features with: the flags, else the run's.
+struct CacheChoice {
+  std::string dir;
+  std::string precision = "fp32";
+};
+
+data::RirSet load_rirs(const std::string& dir, bool progress, const CacheChoice& cache) {
   data::RirLoadOptions load;
   load.progress = progress;
+  load.cache_dir = cache.dir;
+  load.half_precision = data::parse_cache_precision(cache.precision);
   return data::load_rir_set(dir, load);
 }
 
@@ -130,6 +144,7 @@ struct EvalField {
   double audio_fraction = 1;
   std::string grid;
   std::string default_out_dir;  // PNGs and CSVs without --images
+  CacheChoice cache;            // the run's feature cache (before the flags)
 };
 
 // The acoustic field on the test RIRs (and, with --novel-data, on every RIR of another dataset of
@@ -138,7 +153,10 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
   const infer::AudioField& run = source.field;
   const std::string data_dir =
       args.data.empty() ? source.manifest.at("data").get<std::string>() : args.data;
-  const data::RirSet rirs = load_rirs(data_dir, !args.quiet);
+  CacheChoice cache = source.cache;
+  if (args.cache_dir_opt && args.cache_dir_opt->count()) cache.dir = args.cache_dir;
+  if (!args.cache_precision.empty()) cache.precision = args.cache_precision;
+  const data::RirSet rirs = load_rirs(data_dir, !args.quiet, cache);
   infer::check_audio_manifest(source.manifest.at("audio"), rirs, data_dir);
   std::vector<std::pair<std::string, infer::AudioRun>> ablations;
   for (const std::string& dir : split_commas(args.ablation_runs)) {
@@ -160,7 +178,7 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
   // Checked before anything is scored or written.
   std::optional<data::RirSet> novel;
   if (!args.novel_data.empty()) {
-    novel = load_rirs(args.novel_data, !args.quiet);
+    novel = load_rirs(args.novel_data, !args.quiet, cache);
     infer::check_same_room_format(source.manifest.at("audio"), *novel, args.novel_data);
     check_same_gain(data_dir, args.novel_data);
   }
@@ -255,15 +273,24 @@ void register_eval(CLI::App& app) {
       ->check(CLI::IsMember({"fp32", "bf16"}))
       ->needs(run_opt);
   cmd->add_option("--max-views", args->max_views, "Evaluate only the first N eval views")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--threads", args->threads, "CPU threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+      ->transform(whole_number(1, 10000000));
+  cmd->add_option("--threads", args->threads,
+                  "CPU threads (default: all cores; at most 4 x the cores)")
+      ->transform(thread_count());
   cmd->add_flag("--quiet", args->quiet, "No progress bar");
   cmd->add_flag("--skip-vision", args->skip_vision, "Do not evaluate the images (audio only)");
   cmd->add_flag("--no-baselines", args->no_baselines,
                 "Audio: do not score the nearest-neighbour and linear-interpolation baselines");
   cmd->add_option("--max-rirs", args->max_rirs, "Audio: evaluate only the first N test RIRs")
-      ->check(CLI::PositiveNumber);
+      ->transform(whole_number(1, 100000000));
+  args->cache_dir_opt = cmd->add_option(
+      "--cache-dir", args->cache_dir,
+      "Audio: folder of the RIR feature cache (default: the one the run was trained with, "
+      "recorded in RUN/config.json; else DATA/.neraf_cache)");
+  cmd->add_option("--cache-precision", args->cache_precision,
+                  "Audio: feature cache values, fp32 or fp16 (default: the run's, recorded in "
+                  "RUN/config.json; fp32 with --model)")
+      ->check(CLI::IsMember({"fp32", "fp16"}));
   cmd->add_option("--ablation-runs", args->ablation_runs,
                   "Audio: comma-separated run folders of the same dataset (e.g. trained with "
                   "--grid none / zeros) scored on the same test RIRs and added to the table "
@@ -286,7 +313,8 @@ void register_eval(CLI::App& app) {
                        meta.value("seed", uint64_t{0}),
                        meta.value("audio_fraction", 1.0),
                        meta.value("grid", std::string("sampled")),
-                       std::filesystem::path(args->model).replace_extension("").string() + "_eval"};
+                       std::filesystem::path(args->model).replace_extension("").string() + "_eval",
+                       {}};
       nlohmann::json out = {{"model", args->model},
                             {"run", meta.value("run", std::string())},
                             {"checkpoint", meta.value("checkpoint", std::string())},
@@ -308,12 +336,14 @@ void register_eval(CLI::App& app) {
       out["checkpoint"] = audio.run().checkpoint;
       out["step"] = audio.step();
       out["precision"] = args->precision;
-      const EvalField source{audio,
-                             audio.run().manifest,
-                             audio.run().config.seed,
-                             audio.run().config.audio.fraction,
-                             audio.run().config.audio.grid,
-                             (std::filesystem::path(args->run) / "eval").string()};
+      const EvalField source{
+          audio,
+          audio.run().manifest,
+          audio.run().config.seed,
+          audio.run().config.audio.fraction,
+          audio.run().config.audio.grid,
+          (std::filesystem::path(args->run) / "eval").string(),
+          {audio.run().config.audio.cache_dir, audio.run().config.audio.cache_precision}};
       out["audio"] = evaluate_audio_json(source, *args);
     }
     if (!args->skip_vision) {

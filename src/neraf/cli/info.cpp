@@ -8,6 +8,7 @@
 #include <string>
 
 #include "neraf/cli/commands.h"
+#include "neraf/cli/flag_checks.h"
 #include "neraf/data/validate.h"
 #include "neraf/metrics/room_acoustics.h"
 #include "neraf/util/error.h"
@@ -133,12 +134,12 @@ void register_info(CLI::App& app) {
   cmd->add_option("--max-problems", args->max_problems,
                   "Print at most this many problems (0 = all)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->transform(whole_number(0, 10000000));
   cmd->add_option("--t60-sample", args->t60_sample,
                   "Measure T60 on at most this many RIRs (an evenly spaced subset on larger "
                   "datasets; all other checks read every file's header)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->transform(whole_number(1, 100000000));
   cmd->add_flag("--no-t60", args->no_t60, "Skip the T60 summary (reads no audio samples)");
   cmd->add_flag("--json", args->json,
                 "Print the summary and the problem list as JSON on stdout instead of text");

@@ -5,6 +5,7 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <new>
 #include <string>
 
 #include "neraf/cli/commands.h"
@@ -19,6 +20,10 @@ void tune_malloc() {
   mallopt(M_MMAP_MAX, 0);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
 }
+
+constexpr const char* kOutOfMemory =
+    "error: out of memory: the command needs more memory than this machine has free; use smaller "
+    "sizes (--rays, --threads, the dataset or scene) or free memory";
 
 // The deepest subcommand the user named, so a usage error prints that subcommand's usage.
 const CLI::App* selected_command(const CLI::App& app) {
@@ -52,6 +57,7 @@ int main(int argc, char** argv) {
   neraf::cli::register_render(app);
   neraf::cli::register_eval(app);
   neraf::cli::register_export(app);
+  neraf::cli::register_calibrate(app);
   neraf::cli::register_info(app);
   neraf::cli::register_synth(app);
 
@@ -72,10 +78,21 @@ int main(int argc, char** argv) {
   } catch (const neraf::Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;
+  } catch (const std::bad_alloc&) {
+    // Sizes are bounded before work starts; this is what is left (a machine with little free
+    // memory), said in one line instead of "std::bad_alloc".
+    std::fprintf(stderr, "%s\n", kOutOfMemory);
+    return 1;
   } catch (const std::exception& e) {
     // LibTorch and the standard library: keep the first line, which carries the reason.
     std::string what = e.what();
     what = what.substr(0, what.find('\n'));
+    // LibTorch's allocator: "DefaultCPUAllocator: can't allocate memory: you tried to allocate
+    // N bytes. Error code 12 (...)" (and its source location), as one neraf line.
+    if (what.find("can't allocate memory") != std::string::npos) {
+      std::fprintf(stderr, "%s\n", kOutOfMemory);
+      return 1;
+    }
     std::fprintf(stderr, "error: %s\n", what.c_str());
     return 1;
   }

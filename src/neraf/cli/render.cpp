@@ -9,6 +9,7 @@
 #include <string>
 
 #include "neraf/cli/commands.h"
+#include "neraf/cli/flag_checks.h"
 #include "neraf/cli/render_audio.h"
 #include "neraf/infer/run.h"
 #include "neraf/render/view.h"
@@ -41,15 +42,16 @@ void add_render_view(CLI::App& render) {
   cmd->add_option("--run", args->run, "Run folder made by neraf train")->required();
   CLI::Option* frame =
       cmd->add_option("--frame", args->frame, "Index of the eval frame to render (0-based)")
-          ->check(CLI::NonNegativeNumber);
+          ->transform(whole_number(0, 10000000));
   CLI::Option* pose = cmd->add_option("--pose", args->pose, "Camera JSON file (see below)");
   frame->excludes(pose);
   cmd->add_option("--out", args->out, "Output PNG")->required();
   cmd->add_option("--depth", args->depth, "Also write the colour-mapped median depth here (PNG)");
   cmd->add_option("--checkpoint", args->checkpoint,
                   "A specific checkpoint file (default: the run's latest)");
-  cmd->add_option("--threads", args->threads, "CPU threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--threads", args->threads,
+                  "CPU threads (default: all cores; at most 4 x the cores)")
+      ->transform(thread_count());
   cmd->callback([args, frame, pose]() {
     require(frame->count() + pose->count() == 1, "render view: give --frame I or --pose FILE");
     if (args->threads > 0) torch::set_num_threads(args->threads);

@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "neraf/cli/flag_checks.h"
 #include "neraf/dsp/auralize.h"
 #include "neraf/geometry/trajectory.h"
 #include "neraf/infer/audio_run.h"
@@ -118,18 +119,10 @@ void render_pose_list(const LoadedField& field, const FieldArgs& field_args,
     check_inside(poses[i].source, where + " source", info.aabb, field_args.allow_outside);
   }
   std::error_code ec;
-  fs::path out = fs::path(out_dir).lexically_normal();
-  if (!out.has_filename()) out = out.parent_path();  // "rirs/" names the folder rirs
-  require(!fs::exists(out, ec) || (fs::is_directory(out, ec) && fs::is_empty(out, ec)),
+  require(!fs::exists(out_dir, ec) || (fs::is_directory(out_dir, ec) && fs::is_empty(out_dir, ec)),
           out_dir + ": exists and is not an empty folder; choose a new --out folder or remove it");
-  const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");
-  require(fs::is_directory(parent, ec),
-          parent.string() + ": no such folder for --out; create it first");
-  const fs::path tmp = parent / ("." + out.filename().string() + ".tmp-" +
-                                 std::to_string(static_cast<long long>(getpid())));
-  fs::remove_all(tmp, ec);
-  fs::create_directory(tmp);
-  try {
+  io::write_folder_atomically(out_dir, [&](const std::string& tmp_dir) {
+    const fs::path tmp(tmp_dir);
     std::string csv =
         "name,file,mic_x,mic_y,mic_z,src_x,src_y,src_z,yaw_deg,channels,"
         "sample_rate,duration_s,peak\n";
@@ -154,12 +147,7 @@ void render_pose_list(const LoadedField& field, const FieldArgs& field_args,
     }
     progress.finish();
     io::write_text_atomically((tmp / "summary.csv").string(), csv);
-    fs::remove(out, ec);  // an empty folder (checked above), or nothing
-    fs::rename(tmp, out);
-  } catch (...) {
-    fs::remove_all(tmp, ec);
-    throw;
-  }
+  });
   std::printf("wrote %s: %zu RIRs (%s, step %lld) and summary.csv\n", out_dir.c_str(), poses.size(),
               field.name.c_str(), static_cast<long long>(field.step));
 }
@@ -197,8 +185,9 @@ void add_render_rir(CLI::App& render) {
   poses_opt->excludes(args->pose.yaw_opt)->excludes(args->pose.src_yaw_opt);
   cmd->add_option("--out", args->out, "Output WAV (written atomically); with --poses a new folder")
       ->required();
-  cmd->add_option("--threads", args->threads, "CPU threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+  cmd->add_option("--threads", args->threads,
+                  "CPU threads (default: all cores; at most 4 x the cores)")
+      ->transform(thread_count());
   cmd->callback([args, pose_opts, poses_opt] {
     if (args->threads > 0) torch::set_num_threads(args->threads);
     if (poses_opt->count() == 0) {
@@ -242,12 +231,14 @@ void add_render_loudness(CLI::App& render) {
   cmd->add_option("--spacing", args->spacing,
                   "Grid spacing in metres (default 0.1, as the reference; made coarser "
                   "automatically when the grid would exceed 2500 positions)")
-      ->check(CLI::PositiveNumber);
+      ->check(real_number(0.001, 100));
   cmd->add_option("--height", args->height,
                   "Microphone height y in metres (default: the middle of the train microphones' "
-                  "heights, i.e. their height when they share one)");
-  cmd->add_option("--threads", args->threads, "CPU threads (default: all cores)")
-      ->check(CLI::PositiveNumber);
+                  "heights, i.e. their height when they share one)")
+      ->check(real_number(-10000, 10000));
+  cmd->add_option("--threads", args->threads,
+                  "CPU threads (default: all cores; at most 4 x the cores)")
+      ->transform(thread_count());
   cmd->callback([args] {
     if (args->threads > 0) torch::set_num_threads(args->threads);
     const geometry::Vec3 src = parse_flag_position(args->pose.src, "--src");
@@ -303,15 +294,8 @@ std::string audio_pose_help() {
 std::pair<CLI::Option*, CLI::Option*> add_audio_pose_options(CLI::App* cmd, AudioPoseArgs& a,
                                                              bool with_mic, bool required,
                                                              CLI::Option* needs) {
-  const CLI::Validator finite(
-      [](std::string& s) {
-        char* end = nullptr;
-        const double v = std::strtod(s.c_str(), &end);
-        return (end != s.c_str() && *end == '\0' && std::isfinite(v))
-                   ? std::string()
-                   : std::string("must be a finite number of degrees");
-      },
-      "DEG");
+  // Headings in either sense of rotation; beyond one turn is a typo, not a heading.
+  const CLI::Validator degrees = real_number(-360, 360);
   std::vector<CLI::Option*> opts;
   CLI::Option* mic = nullptr;
   if (with_mic) {
@@ -322,15 +306,16 @@ std::pair<CLI::Option*, CLI::Option*> add_audio_pose_options(CLI::App* cmd, Audi
   opts.push_back(src);
   a.yaw_opt =
       cmd->add_option("--yaw", a.yaw, "Receiver heading in degrees (SoundSpaces runs; default 0)")
-          ->check(finite);
+          ->check(degrees);
   a.src_yaw_opt =
       cmd->add_option("--src-yaw", a.src_yaw, "Source yaw in degrees (RAF runs; default 0)")
-          ->check(finite);
+          ->check(degrees);
   opts.push_back(a.yaw_opt);
   opts.push_back(a.src_yaw_opt);
   if (with_mic) {  // an RIR is rendered: Griffin-Lim needs a seed
-    opts.push_back(cmd->add_option("--seed", a.seed,
-                                   "Seed of Griffin-Lim's random initial phases (default 0)"));
+    opts.push_back(
+        cmd->add_option("--seed", a.seed, "Seed of Griffin-Lim's random initial phases (default 0)")
+            ->transform(seed_number()));
   }
   for (CLI::Option* o : opts) {
     if (required && (o == mic || o == src)) o->required();

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "neraf/cli/flag_checks.h"
 #include "neraf/cli/render_audio.h"
 #include "neraf/dsp/auralize.h"
 #include "neraf/dsp/resample.h"
@@ -231,20 +232,21 @@ void add_render_trajectory(CLI::App& render) {
       ->check(CLI::ExistingFile);
   cmd->add_option("--out", args->out, "Output WAV (written atomically)")->required();
   cmd->add_option("--rate", args->rate_hz, "Pose updates per second (a new RIR each)")
-      ->check(CLI::Range(0.01, geometry::kMaxSampleRateHz))
+      ->check(real_number(0.01, geometry::kMaxSampleRateHz))
       ->capture_default_str();
   cmd->add_option("--block", args->block,
                   "Samples per block of the streaming convolver (16 to 16384)")
-      ->check(CLI::Range(16, 16384))
+      ->transform(whole_number(16, 16384))
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "Seed of Griffin-Lim's random initial phases")
+      ->transform(seed_number())
       ->capture_default_str();
   cmd->add_flag("--normalize", args->normalize, "Scale the result so its peak is 0.99");
   cmd->add_option("--frames", args->frames_dir,
                   "Also render a view per video frame into this folder (needs --run with a "
                   "radiance field)");
   cmd->add_option("--fps", args->fps, "Video frames per second for --frames")
-      ->check(CLI::Range(0.01, 120.0))
+      ->check(real_number(0.01, 120))
       ->capture_default_str();
   cmd->callback([args] { run_trajectory(*args); });
 }

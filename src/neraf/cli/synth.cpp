@@ -7,6 +7,7 @@
 #include <string>
 
 #include "neraf/cli/commands.h"
+#include "neraf/cli/flag_checks.h"
 #include "neraf/sim/presets.h"
 #include "neraf/sim/scene_json.h"
 #include "neraf/sim/synthesize.h"
@@ -45,6 +46,8 @@ void run_synth(const SynthArgs& a) {
     std::printf("%s\n", sim::scene_to_json(scene).dump(2).c_str());
     return;
   }
+  // Before the plan (a million microphones would already be gigabytes of jobs) and before --out.
+  sim::check_synthesis_size(scene, a.layout, where, "--mics, --mic-count");
   if (a.dry_run) {
     const sim::SynthPlan plan = sim::plan_synthesis(scene, a.layout, a.seed);
     std::printf(
@@ -120,8 +123,9 @@ void register_synth(CLI::App& app) {
                   "--novel-data DIR")
       ->check(CLI::IsMember({"grid", "random"}));
   cmd->add_option("--mic-count", args->mic_count,
-                  "Number of random microphone positions (with --mics random)")
-      ->check(CLI::Range(1, 1000000));
+                  "Number of random microphone positions (with --mics random; the dataset's "
+                  "size is checked against the limits before anything is written)")
+      ->transform(whole_number(1, 1000000));
   cmd->add_option("--gain-from", args->gain_from,
                   "Scale the RIRs by the gain of this earlier synth folder instead of putting "
                   "the peak at 0.5, so both sets share one scale (needed by eval --novel-data)")
@@ -130,15 +134,18 @@ void register_synth(CLI::App& app) {
   cmd->add_option("--seed", args->seed,
                   "Seed of every random choice (camera and random-microphone placement, splits, "
                   "late-reverb noise)")
+      ->transform(seed_number())
       ->capture_default_str();
-  cmd->add_option("--threads", args->threads, "Worker threads (default: all cores)")
-      ->check(CLI::Range(1, 1024));
+  cmd->add_option("--threads", args->threads,
+                  "Worker threads (default: all cores; at most 4 x the cores)")
+      ->transform(thread_count());
   cmd->add_option("--hrtf", args->hrtf,
                   "SOFA file of the binaural HRTF (default: libmysofa's MIT KEMAR default.sofa)")
       ->check(CLI::ExistingFile);
   cmd->add_flag(
       "--force", args->force,
-      "Write into a non-empty --out folder, replacing files atomically (other files stay)");
+      "Replace a non-empty --out folder (the new dataset is built beside it and swapped in when "
+      "complete; the old folder and everything in it is then deleted)");
   cmd->add_flag("--quiet", args->quiet, "No progress bars");
   cmd->add_flag("--print-scene", args->print_scene,
                 "Print the resolved scene JSON (e.g. of a preset, to edit and pass back with "

@@ -2,6 +2,7 @@
 // periodic atomic checkpoints, --resume, and a checkpoint on Ctrl-C. The flags are resolved into
 // a TrainConfig by infer::resolve_train_config (infer/train_config.h).
 #include <torch/torch.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "neraf/cli/commands.h"
+#include "neraf/cli/flag_checks.h"
 #include "neraf/infer/train_config.h"
 #include "neraf/nerf/config.h"
 #include "neraf/train/interrupt.h"
@@ -39,7 +41,41 @@ struct TrainArgs {
   bool resume = false;
   bool force = false;
   bool quiet = false;
+  std::string cache_dir;
+  std::string cache_precision = "fp32";
+  CLI::Option* cache_dir_opt = nullptr;
+  CLI::Option* cache_precision_opt = nullptr;
+  int keep = 3;
+  int64_t save_every = 0;
 };
+
+// The flag's own bound; the memory check below is the one that usually applies.
+constexpr int64_t kMaxRays = 1000000000;
+
+// Resident memory of one vision step per ray sample (activations and their gradients through the
+// hash grids, proposal networks and MLPs), measured on the cpu preset (224 samples per ray): peak
+// RSS 0.91 GB at 8192 rays, 1.76 GB at 16384, i.e. ~0.1 MB per ray, ~460 B per sample.
+constexpr double kBytesPerRaySample = 500;
+
+// Refuses a --rays batch whose estimated memory exceeds this machine's, before any data is read
+// (a 1e8-ray batch otherwise died in LibTorch's allocator after loading the dataset).
+void check_batch_memory(const infer::TrainConfig& cfg) {
+  if (cfg.modality == infer::Modality::audio) return;  // no rays are cast
+  int64_t samples = cfg.model.sampler.nerf_samples;
+  for (int n : cfg.model.sampler.proposal_samples) samples += n;
+  const double need = double(cfg.rays_per_batch) * double(samples) * kBytesPerRaySample;
+  const double have = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+  if (have <= 0 || need <= 0.5 * have) return;
+  const int64_t most = static_cast<int64_t>(0.5 * have / (double(samples) * kBytesPerRaySample));
+  char buf[320];
+  std::snprintf(buf, sizeof buf,
+                "--rays %lld: a batch of %lld rays x %lld samples needs about %.3g GB of memory; "
+                "the limit is half of this machine's %.3g GB (at most %lld rays); use fewer rays",
+                static_cast<long long>(cfg.rays_per_batch),
+                static_cast<long long>(cfg.rays_per_batch), static_cast<long long>(samples),
+                need / 1e9, have / 1e9, static_cast<long long>(most));
+  throw Error(buf);
+}
 
 }  // namespace
 
@@ -50,8 +86,10 @@ void register_train(CLI::App& app) {
       "Train a scene's radiance and acoustic fields (posed images + RIRs), jointly by default");
   cmd->footer(
       "Writes RUN/config.json (the resolved config), RUN/data.json (dataset manifest) and\n"
-      "RUN/checkpoints/step-XXXXXXXXX.pt. Ctrl-C saves a checkpoint and exits; continue with\n"
-      "--resume. The same --seed and --threads give the same numbers.\n"
+      "RUN/checkpoints/step-XXXXXXXXX.pt (the newest --keep), then fits the acoustic field's\n"
+      "energy calibration (step-XXXXXXXXX.calibration.pt; see neraf calibrate). Ctrl-C saves a\n"
+      "checkpoint and exits; continue with --resume. A second writer on --out is refused.\n"
+      "The same --seed and --threads give the same numbers.\n"
       "Modalities: joint (default; NeRAF: radiance field + acoustic field, the grid sampled\n"
       "from the radiance field every step), vision (radiance field only), audio (acoustic field\n"
       "on the frozen grid of a finished run: --vision-run RUN, the paper's separate training).\n"
@@ -73,14 +111,17 @@ void register_train(CLI::App& app) {
                       "Total training steps (default: cpu 3000 joint, 2000 vision, 1500 audio; "
                       "paper 400001 joint, 30000 vision, 398000 audio). With --resume: train on to "
                       "this step")
-          ->check(CLI::PositiveNumber);
-  CLI::Option* seed = cmd->add_option("--seed", args->seed, "Random seed")->capture_default_str();
-  CLI::Option* threads =
-      cmd->add_option("--threads", args->threads, "CPU threads (default: all cores)")
-          ->check(CLI::PositiveNumber);
+          ->transform(whole_number(1, kMaxSteps));
+  CLI::Option* seed = cmd->add_option("--seed", args->seed, "Random seed")
+                          ->transform(seed_number())
+                          ->capture_default_str();
+  CLI::Option* threads = cmd->add_option("--threads", args->threads,
+                                         "CPU threads (default: all cores; at most 4 x the cores)")
+                             ->transform(thread_count());
   CLI::Option* rays = cmd->add_option("--rays", args->rays,
-                                      "Rays per training batch (default: cpu 2048, paper 4096)")
-                          ->check(CLI::PositiveNumber);
+                                      "Rays per training batch (default: cpu 2048, paper 4096; "
+                                      "refused when the batch would not fit in memory)")
+                          ->transform(whole_number(1, kMaxRays));
   CLI::Option* precision =
       cmd->add_option("--precision", args->precision,
                       "MLP matrix products: bf16 (default where the CPU has AVX-512 bf16), fp32, "
@@ -97,21 +138,22 @@ void register_train(CLI::App& app) {
       cmd->add_option("--audio-fraction", args->audio_fraction,
                       "Few-shot: train the acoustic field on this seeded fraction of the training "
                       "RIRs (0 < F <= 1)")
-          ->check(CLI::Range(1e-9, 1.0))
+          ->check(real_number(0, 1, true))
           ->capture_default_str();
   CLI::Option* vision_run = cmd->add_option(
       "--vision-run", args->vision_run,
       "With --modality audio: the finished vision (or joint) run whose radiance field fills "
       "the grid (frozen)");
-  CLI::Option* audio_start = cmd->add_option(
-      "--audio-start-step", args->audio_start,
-      "Audio losses start after this step (default: the preset's; cpu 1000, paper 2000; audio "
-      "modality 0)");
+  CLI::Option* audio_start = cmd->add_option("--audio-start-step", args->audio_start,
+                                             "Audio losses start after this step (default: the "
+                                             "preset's; cpu 1000, paper 2000; audio "
+                                             "modality 0)")
+                                 ->transform(whole_number(-1, kMaxSteps));
   CLI::Option* decay_loss =
       cmd->add_option("--decay-loss", args->decay_loss,
                       "Weight of the energy-decay loss on whole RIRs (the paper's \"++\" "
                       "variant; default 0 = off, as the reference)")
-          ->check(CLI::NonNegativeNumber);
+          ->check(real_number(0, 1000));
   CLI::Option* no_relative = cmd->add_flag(
       "--no-relative-geometry", args->no_relative_geometry,
       "Give the acoustic field absolute positions only, as the reference does (the cpu "
@@ -122,9 +164,29 @@ void register_train(CLI::App& app) {
   cmd->add_flag("--force", args->force,
                 "Start over in a non-empty --out folder (deletes its checkpoints)");
   cmd->add_flag("--quiet", args->quiet, "No progress bar");
+  args->cache_dir_opt = cmd->add_option(
+      "--cache-dir", args->cache_dir,
+      "Folder of the audio feature cache (default: DATA/.neraf_cache, or ~/.cache/neraf when "
+      "the dataset is read-only); recorded in config.json, so eval finds it");
+  args->cache_precision_opt =
+      cmd->add_option("--cache-precision", args->cache_precision,
+                      "Audio feature cache values: fp32, or fp16 (half the disk and page cache; "
+                      "features rounded to ~1e-3 relative); recorded in config.json")
+          ->check(CLI::IsMember({"fp32", "fp16"}))
+          ->capture_default_str();
+  cmd->add_option("--keep", args->keep,
+                  "Checkpoints to keep, the newest (0: keep all; older ones are deleted as new "
+                  "ones are written)")
+      ->check(CLI::Range(0, 1000000))
+      ->capture_default_str();
+  CLI::Option* save_every =
+      cmd->add_option("--save-every", args->save_every,
+                      "Write a checkpoint every N steps (default: the preset's, 500 for cpu; "
+                      "may change on --resume)")
+          ->check(CLI::Range(int64_t{1}, int64_t{1000000000}));
 
   cmd->callback([args, data, preset, steps, seed, threads, rays, precision, grid, fraction,
-                 vision_run, audio_start, decay_loss, no_relative]() {
+                 vision_run, audio_start, decay_loss, no_relative, save_every]() {
     require(!(args->resume && args->force), "--resume and --force: choose one");
     require(args->resume || data->count() > 0, "--data: required (the dataset folder)");
     // The flags as given (unset: the preset's value for the modality), resolved in one place.
@@ -142,7 +204,10 @@ void register_train(CLI::App& app) {
     if (decay_loss->count()) flags.decay_loss = args->decay_loss;
     flags.no_relative_geometry = args->no_relative_geometry;
     if (vision_run->count()) flags.vision_run = args->vision_run;
-    const infer::TrainConfig cfg = infer::resolve_train_config(flags);
+    infer::TrainConfig cfg = infer::resolve_train_config(flags);
+    cfg.audio.cache_dir = args->cache_dir;
+    cfg.audio.cache_precision = args->cache_precision;
+    if (!args->resume) check_batch_memory(cfg);
     if (cfg.model.precision == nerf::Precision::bf16 && !nerf::cpu_supports_bf16())
       warn("--precision bf16: this CPU has no native bf16 instructions; expect slow training");
 
@@ -152,6 +217,8 @@ void register_train(CLI::App& app) {
     opts.resume = args->resume;
     opts.force = args->force;
     opts.progress = !args->quiet;
+    opts.keep = args->keep;
+    if (save_every->count()) opts.save_every = args->save_every;
     if (args->resume) {
       // The run's own config wins; flags that would change the model are refused.
       for (CLI::Option* o : {preset, seed, rays, precision, grid, fraction, vision_run, audio_start,
@@ -159,6 +226,10 @@ void register_train(CLI::App& app) {
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json is "
                                      "used); start a new run with --out to change it");
+      for (CLI::Option* o : {args->cache_dir_opt, args->cache_precision_opt})
+        require(o->count() == 0, o->get_name() +
+                                     ": cannot change on --resume (the run's config.json records "
+                                     "the cache); start a new run with --out to change it");
       if (steps->count()) opts.steps = args->steps;
       if (threads->count()) opts.threads = args->threads;
     }

@@ -1,36 +1,31 @@
 #include "neraf/data/audio_probe.h"
 
-#include <sndfile.h>
-#include <sys/stat.h>
+#include "neraf/io/audio_file.h"
+#include "neraf/util/error.h"
 
 namespace neraf::data {
 
+std::string strip_path(const std::string& message, const std::string& path) {
+  const std::string prefix = path + ": ";
+  return message.compare(0, prefix.size(), prefix) == 0 ? message.substr(prefix.size()) : message;
+}
+
 AudioProbe probe_audio(const std::string& path) {
   AudioProbe p;
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) {
-    p.error = "no such file";
-    return p;
+  try {
+    const io::AudioFileInfo info = io::read_audio_info(path);
+    // A stream of unknown length (no frame count in its header) is not what a dataset ships.
+    if (info.frames < 0) {
+      p.error = "the header gives no length (a streamed file); re-export it as WAV or FLAC";
+      return p;
+    }
+    p.ok = true;
+    p.sample_rate = info.sample_rate;
+    p.channels = info.channels;
+    p.frames = info.frames;
+  } catch (const Error& e) {
+    p.error = strip_path(e.what(), path);
   }
-  if (S_ISDIR(st.st_mode)) {
-    p.error = "is a folder, not an audio file";
-    return p;
-  }
-  if (st.st_size == 0) {
-    p.error = "the file is empty (0 bytes)";
-    return p;
-  }
-  SF_INFO info{};
-  SNDFILE* f = sf_open(path.c_str(), SFM_READ, &info);
-  if (!f) {
-    p.error = std::string("not a readable audio file (") + sf_strerror(nullptr) + ")";
-    return p;
-  }
-  sf_close(f);
-  p.ok = true;
-  p.sample_rate = info.samplerate;
-  p.channels = info.channels;
-  p.frames = static_cast<int64_t>(info.frames);
   return p;
 }
 

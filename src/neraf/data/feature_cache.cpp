@@ -164,8 +164,10 @@ std::shared_ptr<FeatureCache> FeatureCache::build(
       char buf[200];
       std::snprintf(buf, sizeof buf, "the feature cache needs %.1f GB but only %.1f GB are free",
                     layout.total / 1e9, free_bytes / 1e9);
-      throw Error(path + ": " + buf +
-                  "; free space, pass --cache-dir on a larger disk, or use a float16 cache");
+      throw Error(
+          path + ": " + buf +
+          "; free space, pass --cache-dir on a larger disk, or --cache-precision fp16 (half the "
+          "size)");
     }
   }
 

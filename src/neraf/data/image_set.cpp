@@ -9,10 +9,12 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "neraf/io/atomic_file.h"
 #include "neraf/io/json_file.h"
+#include "neraf/io/png.h"
 #include "neraf/util/error.h"
 #include "neraf/util/log.h"
 #include "neraf/util/progress.h"
@@ -24,6 +26,10 @@ namespace neraf::data {
 namespace {
 
 using Mat3 = std::array<std::array<double, 3>, 3>;
+
+// Largest |camera position| accepted (the scene's units, metres for every dataset neraf reads),
+// the bound of every other pose file (rir_check.h).
+constexpr double kMaxAbsTranslation = 1e4;
 
 struct Frame {
   int json_index = 0;     // index in transforms.json "frames" (what users can find in the file)
@@ -128,6 +134,16 @@ void read_pose(const json& frame, Frame& f, ProblemList& problems, const std::st
       }
     }
   }
+  // A camera 1e300 away is damage, not a scene: it would set the auto-scale and squash every
+  // other camera onto the origin.
+  for (int r = 0; r < 3; ++r)
+    if (!(std::abs(f.pose[r][3]) <= kMaxAbsTranslation)) {
+      problems.error(file,
+                     where + ": transform_matrix[" + std::to_string(r) +
+                         "][3] is an implausible camera position (|t| > 10000)",
+                     "fix or drop the frame (positions are in the scene's units, e.g. metres)");
+      return;
+    }
   // Rigid check: R^T R = I and det R = +1 (a camera matrix that scales, shears or mirrors would
   // give wrong rays silently).
   double worst = 0;
@@ -318,6 +334,24 @@ Parsed parse(const std::string& path_in, const ImageLoadOptions& options, Proble
     read_pose(fr, f, problems, file);
     out.frames.push_back(std::move(f));
   }
+  // The same image listed twice would be trained on twice as often (and counted twice in the
+  // eval metrics); almost always a merge or copy-paste mistake.
+  {
+    std::map<std::string, int> first;
+    std::vector<Frame> unique;
+    for (Frame& f : out.frames) {
+      const auto [it, fresh] = first.emplace(f.path, f.json_index);
+      if (fresh) {
+        unique.push_back(std::move(f));
+        continue;
+      }
+      problems.error(file,
+                     frame_name(f) + ": lists the same image as frames[" +
+                         std::to_string(it->second) + "] (duplicate frame)",
+                     "remove one of the two frames from transforms.json");
+    }
+    out.frames = std::move(unique);
+  }
   // nerfstudio sorts the frames by file path before anything else (split indices depend on it).
   std::stable_sort(out.frames.begin(), out.frames.end(),
                    [](const Frame& a, const Frame& b) { return path_less(a.path, b.path); });
@@ -331,6 +365,14 @@ void check_images(Parsed& p, ProblemList& problems) {
     if (!fs::exists(f.path, ec)) {
       problems.error(p.json_path, frame_name(f) + ": image " + f.path + " does not exist",
                      "add the image or remove the frame from transforms.json");
+      continue;
+    }
+    // stb_image accepts a file cut short and decodes its missing part as zeros.
+    const std::string damage = io::image_file_problem(f.path);
+    if (!damage.empty()) {
+      problems.error(p.json_path,
+                     frame_name(f) + ": image " + f.path + " is unusable (" + damage + ")",
+                     "re-copy or re-export the image");
       continue;
     }
     int w = 0, h = 0, n = 0;
@@ -436,8 +478,28 @@ void split_indices(const Parsed& p, const ImageLoadOptions& options, ProblemList
   }
 }
 
+// Decodes every image that passed the header checks (in parallel, one image per thread in memory
+// at a time), so that validation finds what the pixel loader would throw on.
+void check_decodes(const Parsed& p, ProblemList& problems) {
+  const int64_t n = static_cast<int64_t>(p.frames.size());
+  std::vector<std::string> failures(static_cast<size_t>(n));
+#pragma omp parallel for schedule(dynamic)
+  for (int64_t k = 0; k < n; ++k) {
+    const Frame& f = p.frames[k];
+    if (!f.image_ok) continue;
+    int w = 0, h = 0, c = 0;
+    stbi_uc* px = stbi_load(f.path.c_str(), &w, &h, &c, 3);
+    if (!px || w != f.image_w || h != f.image_h)
+      failures[k] = frame_name(f) + ": image " + f.path + " cannot be decoded (" +
+                    (px ? "its size changed" : "damaged image data") + ")";
+    if (px) stbi_image_free(px);
+  }
+  for (const std::string& msg : failures)
+    if (!msg.empty()) problems.error(p.json_path, msg, "re-export the image as PNG or JPEG");
+}
+
 ImageSet build(const std::string& path, const ImageLoadOptions& options, ProblemList& problems,
-               bool decode) {
+               bool decode, bool verify_pixels = false) {
   Parsed p = parse(path, options, problems);
   ImageSet set;
   set.source = p.json_path;
@@ -543,7 +605,11 @@ ImageSet build(const std::string& path, const ImageLoadOptions& options, Problem
   fill(set.train, train, true);
   fill(set.eval, eval, false);
 
-  if (!decode || problems.num_errors() > 0 || !first) return set;
+  if (!decode) {
+    if (verify_pixels) check_decodes(p, problems);
+    return set;
+  }
+  if (problems.num_errors() > 0 || !first) return set;
 
   const int H = first->image_h, W = first->image_w;
   ProgressOptions popt;
@@ -582,7 +648,7 @@ ImageSet build(const std::string& path, const ImageLoadOptions& options, Problem
 
 ImageSet check_transforms_json(const std::string& path, const ImageLoadOptions& options,
                                ProblemList& problems) {
-  return build(path, options, problems, /*decode=*/false);
+  return build(path, options, problems, /*decode=*/false, /*verify_pixels=*/true);
 }
 
 ImageSet load_transforms_json(const std::string& path, const ImageLoadOptions& options) {

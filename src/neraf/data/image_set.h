@@ -54,13 +54,15 @@ struct ImageLoadOptions {
 // Reads a nerfstudio transforms.json (a path to the file, or the folder holding it) the way
 // nerfstudio's NerfstudioDataParser does: frames sorted by file path, OPENCV intrinsics global or
 // per frame, poses normalised over all frames (orientation, centring on the mean camera position,
-// auto-scale) before the split. Every problem (missing or unreadable image, size ≠ intrinsics,
-// NaN / non-rigid camera matrix, empty train split) is reported with the frame index and file;
-// all of them are collected first and then thrown as one neraf::Error.
+// auto-scale) before the split. Every problem (a frame listed twice, missing, unreadable or cut
+// short image, size ≠ intrinsics, NaN / non-rigid / implausibly far camera, empty train split) is
+// reported with the frame index and file; all of them are collected first and then thrown as one
+// neraf::Error.
 ImageSet load_transforms_json(const std::string& path, const ImageLoadOptions& options = {});
 
 // Same checks, without throwing: appends the problems to `problems` and returns what could be
-// read (pixels are never decoded here).
+// read. Every image is also decoded (and dropped), so that what the pixel loader would refuse is
+// found here; `images` stays undefined.
 ImageSet check_transforms_json(const std::string& path, const ImageLoadOptions& options,
                                ProblemList& problems);
 

@@ -21,6 +21,19 @@ void ProblemList::warning(std::string file, std::string what, std::string fix) {
   items_.push_back({Problem::Severity::warning, std::move(file), std::move(what), std::move(fix)});
 }
 
+void ProblemList::error_from_message(const std::string& file, const std::string& message) {
+  const std::string prefix = file + ": ";
+  std::string what =
+      message.compare(0, prefix.size(), prefix) == 0 ? message.substr(prefix.size()) : message;
+  std::string fix;
+  const size_t semi = what.rfind("; ");
+  if (semi != std::string::npos) {
+    fix = what.substr(semi + 2);
+    what.resize(semi);
+  }
+  error(file, std::move(what), std::move(fix));
+}
+
 void ProblemList::append(const std::vector<Problem>& more) {
   items_.insert(items_.end(), more.begin(), more.end());
 }

@@ -22,6 +22,9 @@ class ProblemList {
  public:
   void error(std::string file, std::string what, std::string fix);
   void warning(std::string file, std::string what, std::string fix);
+  // An error from a neraf::Error's one-line message "<file>: <what>; <fix>": the leading file is
+  // dropped (the Problem names it) and the text after the last "; " becomes the fix.
+  void error_from_message(const std::string& file, const std::string& message);
   void add(Problem p) { items_.push_back(std::move(p)); }
   void append(const std::vector<Problem>& more);
 

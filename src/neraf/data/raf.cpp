@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "neraf/data/audio_probe.h"
+#include "neraf/data/rir_check.h"
 #include "neraf/data/rir_layouts.h"
 #include "neraf/dsp/stft.h"
 #include "neraf/geometry/quaternion.h"
@@ -48,16 +49,12 @@ bool read_numbers(const std::string& path, std::vector<double>& out, std::string
   return true;
 }
 
-bool all_finite(const std::vector<double>& v) {
-  return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
-}
-
 // Python's round(): halves go to the even neighbour (std::nearbyint in the default mode).
 int round_half_even(double v) { return static_cast<int>(std::nearbyint(v)); }
 
-std::vector<float> read_mono48k(const std::string& wav) {
+std::vector<float> read_mono48k(const std::string& wav, ProblemList& problems) {
   const AudioProbe p = probe_audio(wav);
-  require(p.ok, wav + ": " + p.error + "; restore the file from the RAF release");
+  require(p.ok, wav + ": " + p.error);
   require(p.sample_rate == kRafRate,
           wav + ": sample rate " + std::to_string(p.sample_rate) +
               " Hz, RAF RIRs must be 48000 Hz (the published code supports only 48 kHz); "
@@ -65,7 +62,9 @@ std::vector<float> read_mono48k(const std::string& wav) {
   require(p.channels == 1, wav + ": " + std::to_string(p.channels) +
                                " channels, RAF RIRs must be mono; keep one channel");
   if (p.frames == 0) return {};
-  return std::move(io::read_audio(wav).channels[0]);
+  io::AudioBuffer a = io::read_audio(wav);
+  check_rir_samples(wav, a.channels, problems);
+  return std::move(a.channels[0]);
 }
 
 }  // namespace
@@ -173,15 +172,21 @@ RirIndex index_raf(const std::string& dir, ProblemList& problems) {
                        "restore the file from the RAF release");
         continue;
       }
-      if (!all_finite(rx)) {
-        problems.error(rx_path, "microphone position has a NaN or infinite coordinate",
-                       "fix the file or remove the id from the split");
+      if (!sane_coordinates(rx.data(), 3)) {
+        problems.error(rx_path,
+                       "microphone position has a NaN, infinite or implausible coordinate "
+                       "(|x| > 10000 m)",
+                       "fix the file (metres) or remove the id from the split");
         continue;
       }
+      // The quaternion's scale does not matter (it is normalised), but 1e300 components overflow.
       const double qn = std::sqrt(tx[0] * tx[0] + tx[1] * tx[1] + tx[2] * tx[2] + tx[3] * tx[3]);
-      if (!all_finite(tx) || !(qn > 1e-9)) {
-        problems.error(tx_path, "source pose has a NaN/infinite value or a zero quaternion",
-                       "fix the file or remove the id from the split");
+      if (!sane_coordinates(tx.data(), 7) || !(qn > 1e-9)) {
+        problems.error(
+            tx_path,
+            "source pose has a NaN, infinite or implausible value (|x| > 10000) or a "
+            "zero quaternion",
+            "fix the file (qx,qy,qz,qw,x,y,z in metres) or remove the id from the split");
         continue;
       }
       rir.mic = {rx[0], rx[1], rx[2]};
@@ -202,10 +207,11 @@ RirIndex index_raf(const std::string& dir, ProblemList& problems) {
   return idx;
 }
 
-int64_t raf_features(const std::string& wav, int64_t max_len, float* out) {
+int64_t raf_features(const std::string& wav, int64_t max_len, float* out, ProblemList& problems) {
   // First 0.32 s (zero-padded when a file is shorter, which the released RIRs never are), STFT
   // n_fft 1024 / win 512 / hop 256 -> 61 frames, of which max_len (60) are kept.
-  std::vector<float> x = read_mono48k(wav);
+  std::vector<float> x = read_mono48k(wav, problems);
+  problems.throw_if_errors(wav);
   x.resize(static_cast<size_t>(kRafSamples), 0.0f);
   const dsp::StftParams params = dsp::StftParams::raf();
   const dsp::Matrix mag = dsp::magnitude(dsp::stft(x, params));
@@ -214,7 +220,8 @@ int64_t raf_features(const std::string& wav, int64_t max_len, float* out) {
 }
 
 std::vector<std::vector<float>> raf_waveform(const std::string& wav, int64_t length) {
-  std::vector<float> x = read_mono48k(wav);
+  ProblemList problems;  // warnings (silence) were reported when the features were made
+  std::vector<float> x = read_mono48k(wav, problems);
   x.resize(static_cast<size_t>(length), 0.0f);
   return {std::move(x)};
 }

@@ -29,9 +29,13 @@ RirIndex index_soundspaces(const std::string& dir, bool use_magnitude_files, Pro
 RirIndex index_raf(const std::string& dir, ProblemList& problems);
 
 // Fills out[max_len][C][F] with the padded log-magnitudes; returns the RIR's own frame count.
-int64_t soundspaces_features_from_wav(const std::string& wav, int64_t max_len, float* out);
-int64_t soundspaces_features_from_npy(const std::string& npy, int64_t max_len, float* out);
-int64_t raf_features(const std::string& wav, int64_t max_len, float* out);
+// The samples / magnitudes read are checked as validation checks them (rir_check.h): errors are
+// thrown, warnings (silence) appended to `problems`.
+int64_t soundspaces_features_from_wav(const std::string& wav, int64_t max_len, float* out,
+                                      ProblemList& problems);
+int64_t soundspaces_features_from_npy(const std::string& npy, int64_t max_len, float* out,
+                                      ProblemList& problems);
+int64_t raf_features(const std::string& wav, int64_t max_len, float* out, ProblemList& problems);
 
 // STFT frames the SoundSpaces recipe yields for a 44.1 kHz file of n samples (without reading it).
 int64_t soundspaces_num_frames(int64_t n_samples_44k);

@@ -15,11 +15,11 @@
 #include <mutex>
 #include <sstream>
 
-#include "neraf/data/audio_probe.h"
 #include "neraf/data/feature_cache.h"
 #include "neraf/data/layout.h"
+#include "neraf/data/rir_check.h"
 #include "neraf/data/rir_layouts.h"
-#include "neraf/io/npy.h"
+#include "neraf/io/atomic_file.h"
 #include "neraf/util/error.h"
 #include "neraf/util/log.h"
 
@@ -229,46 +229,57 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
 
   std::shared_ptr<FeatureCache> cache = FeatureCache::open(path, spec);
   if (!cache) {
-    if (spec.max_len == 0) {
-      // SoundSpaces automatic max_len: the longest STFT over all RIRs, from the headers only.
-      std::vector<int64_t> frames(n, 0);
-      detail::parallel_for_each(n, [&](int64_t i) {
-        if (npy) {
-          const io::NpyHeader h = io::read_npy_header(set.rirs[i].magnitude_path);
-          require(h.shape.size() == 3,
-                  set.rirs[i].magnitude_path +
-                      ": expected magnitudes of shape [2, 257, T]; re-create it");
-          frames[i] = h.shape[2];
-        } else {
-          const AudioProbe p = probe_audio(set.rirs[i].wav_path);
-          require(p.ok, set.rirs[i].wav_path + ": " + p.error + "; restore the file");
-          frames[i] = detail::soundspaces_num_frames(p.frames);
-        }
-      });
+    // Every file is checked as `neraf info` checks it before anything is computed (a valid cache
+    // was made from these very files, checked then: the key hashes their size and time).
+    std::vector<detail::RirHeader> headers;
+    ProblemList problems = detail::check_rir_headers(set, headers);
+    std::vector<int64_t> frames(static_cast<size_t>(n), 0);
+    for (int64_t i = 0; i < n; ++i) frames[i] = headers[i].stft_frames;
+    // SoundSpaces automatic max_len: the longest STFT over all RIRs, from the headers only,
+    // bounded before a byte of the cache is written.
+    if (spec.max_len == 0) detail::check_padded_cache_size(set, frames, spec.half, problems);
+    problems.throw_if_errors(set.root);
+    if (options.progress) problems.print_warnings();
+    if (spec.max_len == 0)
       spec.max_len = std::max<int64_t>(1, *std::max_element(frames.begin(), frames.end()));
-    }
     const int64_t max_len = spec.max_len;
-    const double gb = double(n) * max_len * set.channels * set.n_freq * (spec.half ? 2 : 4) / 1e9;
+    const double gb = detail::cache_bytes(set, max_len, spec.half) / 1e9;
     char msg[160];
     std::snprintf(msg, sizeof msg,
                   "%s: building the audio feature cache (%lld RIRs x %lld frames, %.2f GB)",
                   set.root.c_str(), static_cast<long long>(n), static_cast<long long>(max_len), gb);
     if (options.progress) info(msg);
-    std::function<int64_t(int64_t, float*)> compute;
+    // Temporary files of builds that were killed (SIGKILL cannot be caught) can be huge.
+    io::remove_stale_temporaries(dir);
+    std::function<int64_t(int64_t, float*, ProblemList&)> recipe;
     if (!ss)
-      compute = [&](int64_t i, float* out) {
-        return detail::raf_features(set.rirs[i].wav_path, max_len, out);
+      recipe = [&](int64_t i, float* out, ProblemList& p) {
+        return detail::raf_features(set.rirs[i].wav_path, max_len, out, p);
       };
     else if (npy)
-      compute = [&](int64_t i, float* out) {
-        return detail::soundspaces_features_from_npy(set.rirs[i].magnitude_path, max_len, out);
+      recipe = [&](int64_t i, float* out, ProblemList& p) {
+        return detail::soundspaces_features_from_npy(set.rirs[i].magnitude_path, max_len, out, p);
       };
     else
-      compute = [&](int64_t i, float* out) {
-        const int64_t t = detail::soundspaces_features_from_wav(set.rirs[i].wav_path, max_len, out);
-        return t;
+      recipe = [&](int64_t i, float* out, ProblemList& p) {
+        return detail::soundspaces_features_from_wav(set.rirs[i].wav_path, max_len, out, p);
       };
+    std::vector<ProblemList> warnings(static_cast<size_t>(n));
+    const std::function<int64_t(int64_t, float*)> compute = [&](int64_t i, float* out) {
+      // Checked per RIR, so a stop is honoured within one RIR's work; the throw makes the build
+      // remove its temporary file.
+      if (options.stop && options.stop->load(std::memory_order_relaxed))
+        throw Error(set.root +
+                    ": interrupted while building the audio feature cache; nothing was kept, "
+                    "run the command again to build it");
+      return recipe(i, out, warnings[i]);
+    };
     cache = FeatureCache::build(path, spec, compute, options.progress);
+    if (options.progress) {
+      ProblemList found;
+      for (const ProblemList& w : warnings) found.append(w.items());
+      found.print_warnings();
+    }
     // Drop caches of this dataset made for older files or other parameters (they can be huge).
     std::error_code ec;
     for (const auto& e : fs::directory_iterator(dir, ec)) {
@@ -316,6 +327,12 @@ RirSet load_soundspaces(const std::string& dir, const RirLoadOptions& options) {
 
 RirSet load_raf(const std::string& dir, const RirLoadOptions& options) {
   return load(dir, AudioLayout::raf, options);
+}
+
+bool parse_cache_precision(const std::string& text, const std::string& flag) {
+  if (text == "fp32") return false;
+  if (text == "fp16") return true;
+  throw Error(flag + ": unknown cache precision \"" + text + "\"; use fp32 or fp16");
 }
 
 RirSet load_rir_set(const std::string& dir, const RirLoadOptions& options) {

@@ -19,6 +19,7 @@
 #include <torch/torch.h>
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -75,7 +76,15 @@ struct RirLoadOptions {
   bool half_precision = false;  // float16 cache: half the disk, ~1e-3 relative rounding
   bool use_magnitude_files = true;  // SoundSpaces: prefer the published .npy magnitudes
   bool progress = true;
+  // Polled by the feature-cache workers (e.g. the train command's Ctrl-C flag): when it turns
+  // true the build stops, its temporary file is removed and loading throws neraf::Error.
+  const std::atomic<bool>* stop = nullptr;
 };
+
+// The cache precision as the commands take it (--cache-precision, a run's
+// audio.cache_precision): "fp32" -> false, "fp16" -> true (RirLoadOptions::half_precision);
+// neraf::Error naming `flag` for anything else.
+bool parse_cache_precision(const std::string& text, const std::string& flag = "--cache-precision");
 
 struct RirSet {
   AudioLayout layout = AudioLayout::soundspaces;

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "neraf/data/audio_probe.h"
+#include "neraf/data/rir_check.h"
 #include "neraf/data/rir_layouts.h"
 #include "neraf/dsp/resample.h"
 #include "neraf/dsp/stft.h"
@@ -56,10 +57,10 @@ std::vector<float> clipped(std::vector<float> x) {
 }
 
 // Reads a SoundSpaces wav as [2][n] (an empty, header-only file gives two empty channels, as the
-// reference's zero-length read does).
-std::vector<std::vector<float>> read_binaural(const std::string& wav) {
+// reference's zero-length read does), with the checks validation runs on it.
+std::vector<std::vector<float>> read_binaural(const std::string& wav, ProblemList& problems) {
   const AudioProbe p = probe_audio(wav);
-  require(p.ok, wav + ": " + p.error + "; restore the file from the SoundSpaces release");
+  require(p.ok, wav + ": " + p.error);
   require(p.sample_rate == kSoundSpacesWavRate,
           wav + ": sample rate " + std::to_string(p.sample_rate) +
               " Hz, SoundSpaces RIRs must be 44100 Hz; resample the file to 44.1 kHz");
@@ -67,6 +68,7 @@ std::vector<std::vector<float>> read_binaural(const std::string& wav) {
                                " channel(s), SoundSpaces RIRs must be binaural (2 channels)");
   if (p.frames == 0) return {{}, {}};
   io::AudioBuffer a = io::read_audio(wav);
+  check_rir_samples(wav, a.channels, problems);
   return std::move(a.channels);
 }
 
@@ -123,11 +125,11 @@ RirIndex index_soundspaces(const std::string& dir, bool use_magnitude_files,
                        "fix the line");
         continue;
       }
-      if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
-        problems.error(
-            points_path,
-            where + ": point " + std::to_string(id) + " has a NaN or infinite coordinate",
-            "fix the coordinates or remove the point and the RIRs that use it");
+      if (!sane_coordinates(v, 3)) {
+        problems.error(points_path,
+                       where + ": point " + std::to_string(id) +
+                           " has a NaN, infinite or implausible coordinate (|x| > 10000 m)",
+                       "fix the coordinates (metres) or remove the point and the RIRs that use it");
         continue;
       }
       if (points.count(id)) {
@@ -255,10 +257,12 @@ int64_t soundspaces_num_frames(int64_t n) {
   return dsp::stft_num_frames(static_cast<size_t>(len), dsp::StftParams::soundspaces());
 }
 
-int64_t soundspaces_features_from_wav(const std::string& wav, int64_t max_len, float* out) {
+int64_t soundspaces_features_from_wav(const std::string& wav, int64_t max_len, float* out,
+                                      ProblemList& problems) {
   // process_audio.ipynb: clip, fix_length to 4410 if shorter, resample 44.1 -> 22.05 kHz, clip,
   // right-pad n_fft/2 = 256 zeros and to >= 4410 samples, |STFT(512, 128, 512)|.
-  const auto channels = read_binaural(wav);
+  const auto channels = read_binaural(wav, problems);
+  problems.throw_if_errors(wav);
   const dsp::StftParams params = dsp::StftParams::soundspaces();
   std::vector<dsp::Matrix> mags;
   for (const auto& ch : channels) {
@@ -275,19 +279,13 @@ int64_t soundspaces_features_from_wav(const std::string& wav, int64_t max_len, f
   return n_frames;
 }
 
-int64_t soundspaces_features_from_npy(const std::string& npy, int64_t max_len, float* out) {
+int64_t soundspaces_features_from_npy(const std::string& npy, int64_t max_len, float* out,
+                                      ProblemList& problems) {
   const io::NpyArray a = io::read_npy(npy);
   const int64_t n_freq = dsp::StftParams::soundspaces().n_freq();
-  require(a.shape.size() == 3 && a.shape[0] == 2 && a.shape[1] == n_freq && a.shape[2] > 0,
-          npy +
-              ": expected magnitudes of shape [2, 257, T], got a different shape; re-create "
-              "the file or delete binaural_magnitudes_sr22050/ to compute features from the wavs");
+  check_magnitudes(npy, a, n_freq, problems);
+  problems.throw_if_errors(npy);
   const int64_t n_frames = a.shape[2];
-  require(
-      std::all_of(a.data.begin(), a.data.end(), [](float v) { return std::isfinite(v) && v >= 0; }),
-      npy +
-          ": contains negative or non-finite magnitudes; re-create the file or delete "
-          "binaural_magnitudes_sr22050/ to compute features from the wavs");
   write_padded_log({a.data.data(), a.data.data() + n_freq * n_frames}, n_freq, n_frames, max_len,
                    out);
   return n_frames;
@@ -296,7 +294,8 @@ int64_t soundspaces_features_from_npy(const std::string& npy, int64_t max_len, f
 std::vector<std::vector<float>> soundspaces_waveform(const std::string& wav, int64_t length) {
   // SoundSpacesDataset.get_data_eval: clip, resample to 22.05 kHz, cut / zero-pad (no minimum
   // length and no second clip on this path). An empty file is all zeros.
-  auto channels = read_binaural(wav);
+  ProblemList problems;  // warnings (silence) were reported when the features were made
+  auto channels = read_binaural(wav, problems);
   std::vector<std::vector<float>> out;
   for (auto& ch : channels) {
     std::vector<float> y =

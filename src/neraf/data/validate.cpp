@@ -11,6 +11,7 @@
 
 #include "neraf/data/audio_probe.h"
 #include "neraf/data/image_set.h"
+#include "neraf/data/rir_check.h"
 #include "neraf/data/rir_layouts.h"
 #include "neraf/io/npy.h"
 #include "neraf/util/error.h"
@@ -63,10 +64,12 @@ bool zeroed(const geometry::Vec3& p, const Aabb& box) {
   return q.x == 0 && q.y == 0 && q.z == 0;
 }
 
-// Per-RIR header check result (filled in parallel, reported in order).
+// What one RIR's check found (filled in parallel, reported in order).
 struct AudioCheck {
-  AudioProbe probe;
-  std::string npy_error;  // SoundSpaces magnitude file problem
+  detail::RirHeader header;
+  ProblemList problems;
+  std::vector<double> t60;  // per channel, when this RIR was picked for the T60 summary
+  bool t60_measured = false;
 };
 
 void inspect_audio(DatasetReport& r, AudioLayout layout, const InspectOptions& options,
@@ -83,23 +86,46 @@ void inspect_audio(DatasetReport& r, AudioLayout layout, const InspectOptions& o
   const int64_t n = set.size();
   if (n == 0) return;
 
+  // T60 on at most max_sample_reads RIRs, evenly spaced (deterministic).
+  const int64_t m = std::min<int64_t>(n, std::max<int64_t>(options.max_sample_reads, 1));
+  std::vector<char> picked(static_cast<size_t>(n), 0);
+  for (int64_t k = 0; k < m; ++k) picked[k * n / m] = 1;
+  r.t60_subsampled = m < n;
+
+  // Every file is read in full, with the very checks the loaders and feature recipes run
+  // (rir_check.h): "0 errors" here means training accepts the data.
   std::vector<AudioCheck> checks(static_cast<size_t>(n));
   {
     ProgressOptions popt;
     popt.unit = "file";
-    popt.enabled = options.progress && n >= 2000;
-    Progress bar("checking audio headers", n, popt);
+    popt.enabled = options.progress && n >= 500;
+    Progress bar("checking audio files", n, popt);
     std::atomic<int64_t> done{0};
     detail::parallel_for_each(n, [&](int64_t i) {
       const Rir& rir = set.rirs[i];
-      checks[i].probe = probe_audio(rir.wav_path);
-      if (!rir.magnitude_path.empty()) {
+      AudioCheck& c = checks[i];
+      c.header = detail::check_rir_header(set, i, c.problems);
+      const AudioProbe& p = c.header.probe;
+      const bool readable = p.ok && p.frames > 0 && p.sample_rate == set.wav_sample_rate &&
+                            p.channels == set.channels && p.duration_s() <= detail::kMaxRirSeconds;
+      if (readable) {
         try {
-          const io::NpyHeader h = io::read_npy_header(rir.magnitude_path);
-          if (h.shape.size() != 3 || h.shape[0] != 2 || h.shape[1] != set.n_freq || h.shape[2] < 1)
-            checks[i].npy_error = "magnitudes must have shape [2, 257, T]";
+          const io::AudioBuffer audio = io::read_audio(rir.wav_path);
+          detail::check_rir_samples(rir.wav_path, audio.channels, c.problems);
+          if (options.t60 && picked[i]) {
+            c.t60 = options.t60(audio, layout);
+            c.t60_measured = true;
+          }
         } catch (const Error& e) {
-          checks[i].npy_error = e.what();
+          c.problems.error_from_message(rir.wav_path, e.what());
+        }
+      }
+      if (!rir.magnitude_path.empty() && c.header.stft_frames > 0) {
+        try {
+          detail::check_magnitudes(rir.magnitude_path, io::read_npy(rir.magnitude_path), set.n_freq,
+                                   c.problems);
+        } catch (const Error& e) {
+          c.problems.error_from_message(rir.magnitude_path, e.what());
         }
       }
       const int64_t d = ++done;
@@ -109,37 +135,16 @@ void inspect_audio(DatasetReport& r, AudioLayout layout, const InspectOptions& o
   }
 
   std::vector<double> durations;
+  std::vector<int64_t> frames(static_cast<size_t>(n), 0);
   for (int64_t i = 0; i < n; ++i) {
-    const Rir& rir = set.rirs[i];
-    const AudioProbe& p = checks[i].probe;
-    if (!rir.magnitude_path.empty()) ++r.magnitude_files;
-    if (!checks[i].npy_error.empty())
-      problems.error(rir.magnitude_path, checks[i].npy_error,
-                     "re-create it, or delete binaural_magnitudes_sr22050/ to use the wavs");
-    if (!p.ok) {
-      problems.error(rir.wav_path, p.error, "restore the file from the dataset release");
-      continue;
-    }
-    if (p.sample_rate != r.expected_sample_rate)
-      problems.error(rir.wav_path,
-                     "sample rate " + std::to_string(p.sample_rate) + " Hz, expected " +
-                         std::to_string(r.expected_sample_rate) + " Hz",
-                     std::string("resample it to ") + (ss ? "44.1" : "48") + " kHz");
-    if (p.channels != r.expected_channels)
-      problems.error(rir.wav_path,
-                     std::to_string(p.channels) + " channel(s), expected " +
-                         std::to_string(r.expected_channels) + (ss ? " (binaural)" : " (mono)"),
-                     ss ? "SoundSpaces RIRs must be 2-channel binaural files"
-                        : "RAF RIRs must be mono; keep one channel");
-    if (p.frames == 0)
-      problems.warning(rir.wav_path, "holds no samples (treated as silence, like the reference)",
-                       "restore the file if it should not be empty");
-    else if (!ss && p.frames < detail::kRafSamples)
-      problems.warning(rir.wav_path,
-                       "shorter than 0.32 s (" + std::to_string(p.frames) + " samples)",
-                       "it is zero-padded to 15360 samples");
-    durations.push_back(p.duration_s());
+    const AudioCheck& c = checks[i];
+    problems.append(c.problems.items());
+    if (!set.rirs[i].magnitude_path.empty()) ++r.magnitude_files;
+    if (c.header.probe.ok) durations.push_back(c.header.probe.duration_s());
+    frames[i] = c.header.stft_frames;
   }
+  // The bound training applies before it builds the cache (with the automatic max_len).
+  if (ss) detail::check_padded_cache_size(set, frames, /*half=*/false, problems);
   r.duration_s = compute_stats(durations);
 
   std::vector<geometry::Vec3> mics, sources;
@@ -156,43 +161,18 @@ void inspect_audio(DatasetReport& r, AudioLayout layout, const InspectOptions& o
   }
 
   if (!options.t60) return;
-  // T60 on at most max_sample_reads RIRs, evenly spaced (deterministic), readable ones only.
-  std::vector<int64_t> readable;
-  for (int64_t i = 0; i < n; ++i)
-    if (checks[i].probe.ok && checks[i].probe.frames > 0 &&
-        checks[i].probe.sample_rate == r.expected_sample_rate)
-      readable.push_back(i);
-  const int64_t m = std::min<int64_t>(static_cast<int64_t>(readable.size()),
-                                      std::max<int64_t>(options.max_sample_reads, 1));
-  r.t60_subsampled = m < n;
-  std::vector<int64_t> pick(static_cast<size_t>(m));
-  for (int64_t k = 0; k < m; ++k) pick[k] = readable[k * static_cast<int64_t>(readable.size()) / m];
-  std::vector<std::vector<double>> t60(static_cast<size_t>(m));
-  ProgressOptions popt;
-  popt.unit = "RIR";
-  popt.enabled = options.progress && m >= 200;
-  Progress bar("measuring T60", m, popt);
-  std::atomic<int64_t> done{0};
-  detail::parallel_for_each(m, [&](int64_t k) {
-    try {
-      t60[k] = options.t60(io::read_audio(set.rirs[pick[k]].wav_path), layout);
-    } catch (const Error&) {
-      t60[k] = {std::nan("")};  // unreadable samples: counted as invalid
-    }
-    const int64_t d = ++done;
-    if (omp_get_thread_num() == 0) bar.update(d);
-  });
-  bar.finish();
   std::vector<double> all;
-  for (const auto& v : t60)
-    for (const double x : v) {
+  for (const AudioCheck& c : checks) {
+    if (!c.t60_measured) continue;
+    ++r.t60_rirs;
+    for (const double x : c.t60) {
       if (std::isnan(x))
         ++r.t60_invalid;
       else
         all.push_back(x);
     }
+  }
   r.t60_s = compute_stats(all);
-  r.t60_rirs = m;
 }
 
 std::string fmt_stats(const Stats& s, const char* unit, int prec = 3) {

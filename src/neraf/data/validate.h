@@ -3,12 +3,16 @@
 // loaders would read, and summarises what is there. Returns the problems as a list instead of
 // throwing, so callers decide what to do (the CLI prints them and exits non-zero on errors).
 //
-// What is checked: split files and point/pose files (malformed entries, duplicate ids, entries
-// without files, NaN/infinite positions or quaternions), every RIR's audio header (unreadable,
-// wrong sample rate, wrong channel count, empty), SoundSpaces magnitude files (shape), images
-// (listed but absent, unreadable, size ≠ intrinsics, non-rigid or NaN camera matrices, empty
-// split). Headers only: cheap even for 120k RIRs. Only the T60 summary reads samples, on an evenly
-// spaced subset when there are more than InspectOptions::max_sample_reads RIRs.
+// What is checked is what the loaders reject, through the same functions (rir_check.h,
+// image_set.h), so "0 errors" means training accepts the data: split files and point/pose files
+// (malformed entries, duplicate ids, entries without files, NaN, infinite or implausible
+// (|x| > 10 km) positions or quaternions), every RIR file read in full (unreadable, truncated,
+// wrong sample rate or channel count, longer than 30 s, NaN / infinite / huge samples; empty or
+// all-zero → warning), SoundSpaces magnitude files (shape, NaN / negative / huge values), the
+// feature cache the automatic max_len would make (one outlier RIR padding it many times over),
+// images (listed twice, absent, cut short, undecodable, size ≠ intrinsics, non-rigid, NaN or
+// implausible camera matrices, empty split). The T60 summary runs on an evenly spaced subset when
+// there are more than InspectOptions::max_sample_reads RIRs.
 #include <cstdint>
 #include <functional>
 #include <limits>

@@ -8,10 +8,12 @@
 #include <filesystem>
 
 #include "neraf/acoustic/calibration.h"
+#include "neraf/infer/calibration.h"
 #include "neraf/dsp/griffin_lim.h"
 #include "neraf/infer/checkpoint.h"
 #include "neraf/io/json_file.h"
 #include "neraf/util/error.h"
+#include "neraf/util/log.h"
 
 namespace fs = std::filesystem;
 
@@ -101,7 +103,7 @@ void check_audio_manifest(const nlohmann::json& manifest, const data::RirSet& ri
     require(manifest.value(key, nlohmann::json()) == now[key],
             where + ": was trained on another RIR dataset (" + key +
                 " differs: " + manifest.value(key, nlohmann::json()).dump() + " vs " +
-                now[key].dump() + "); use the original --data or a new --out folder");
+                now[key].dump() + "); use the original --data (or, for neraf train, a new --out folder)");
 }
 
 void check_same_room_format(const nlohmann::json& manifest, const data::RirSet& rirs,
@@ -171,7 +173,8 @@ torch::Tensor AudioRun::predict_log_stft_batch(const torch::Tensor& mic, const t
 }
 
 AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
-                        const std::string& checkpoint, nerf::Precision precision) {
+                        const std::string& checkpoint, nerf::Precision precision,
+                        bool calibrated) {
   std::error_code ec;
   const std::string config_path = (fs::path(run_dir) / "config.json").string();
   const std::string manifest_path = (fs::path(run_dir) / "data.json").string();
@@ -216,12 +219,19 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
     load_module(*out.model_, m, out.run_.checkpoint);
     branch.read("grid", g);
     load_module(*grid, g, out.run_.checkpoint);
-    c10::IValue calibration;  // absent in checkpoints written before it existed
-    if (out.run_.config.audio.energy_calibration && branch.try_read("calibration", calibration))
-      out.calibration_ = calibration.toTensor().to(device);
     torch::Tensor step;
     a.read("step", step);
     out.run_.step = step.item<int64_t>();
+    c10::IValue legacy;  // checkpoints written before the calibration stage held their gains
+    if (calibrated && out.run_.config.audio.energy_calibration) {
+      if (auto gains = load_calibration(out.run_.checkpoint, out.run_.step))
+        out.calibration_ = gains->to(device);
+      else if (branch.try_read("calibration", legacy))
+        out.calibration_ = legacy.toTensor().to(device);
+      else
+        warn(out.run_.checkpoint + ": not calibrated (training stopped before its calibration "
+             "stage); predictions are uncalibrated until you run: neraf calibrate --run " + run_dir);
+    }
   } catch (const c10::Error& e) {
     std::string what = e.what_without_backtrace();
     throw Error(out.run_.checkpoint + ": checkpoint does not match the run's config (" +

@@ -77,7 +77,7 @@ class AudioRun final : public AudioField {
                                        const torch::Tensor& yaw_deg) const override;
 
   // Low level: normalised inputs (mic_norm, src_norm, rot: [3] each) → [C, F, T], with the
-  // checkpoint's energy calibration applied when it has one.
+  // energy calibration applied when the run was loaded with one.
   torch::Tensor predict_normalised(const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
                                    const torch::Tensor& rot) const;
 
@@ -90,7 +90,7 @@ class AudioRun final : public AudioField {
 
  private:
   friend AudioRun load_audio_run(const std::string&, torch::Device, const std::string&,
-                                 nerf::Precision);
+                                 nerf::Precision, bool);
   LoadedRun run_;  // run_.model is the radiance field (nullptr-free only for vision/joint runs)
   AudioRunInfo info_;
   acoustic::AcousticModel model_{nullptr};  // eval mode from load on; queries only read it
@@ -100,10 +100,12 @@ class AudioRun final : public AudioField {
 
 // Loads RUN (latest checkpoint, or `checkpoint`) with its acoustic field. Queries run NAcF's
 // trunk in `precision` (fp32 by default, whatever trained the run; bf16: as a bf16 run trained,
-// on machines with native bf16). neraf::Error when the run has no acoustic branch (modality
-// vision) or is broken.
+// on machines with native bf16) and apply the checkpoint's energy calibration (calibration.h)
+// when `calibrated` and the run has one (a warning when the run uses calibration but this step
+// was never calibrated). neraf::Error when the run has no acoustic branch (modality vision) or
+// is broken.
 AudioRun load_audio_run(const std::string& run_dir, torch::Device device = torch::kCPU,
                         const std::string& checkpoint = "",
-                        nerf::Precision precision = nerf::Precision::fp32);
+                        nerf::Precision precision = nerf::Precision::fp32, bool calibrated = true);
 
 }  // namespace neraf::infer

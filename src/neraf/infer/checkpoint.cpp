@@ -1,9 +1,12 @@
 #include "neraf/infer/checkpoint.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <sstream>
 
 #include "neraf/io/atomic_file.h"
+#include "neraf/io/sealed_file.h"
 #include "neraf/util/error.h"
 
 namespace fs = std::filesystem;
@@ -31,45 +34,91 @@ int64_t checkpoint_step_from_name(const std::string& path) {
 }
 
 std::optional<std::string> latest_checkpoint(const std::string& run_dir) {
-  std::error_code ec;
-  const fs::path dir = checkpoint_dir(run_dir);
-  if (!fs::is_directory(dir, ec)) return std::nullopt;
-  int64_t best = -1;
-  std::string best_path;
-  for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    if (!entry.is_regular_file()) continue;
-    const int64_t s = checkpoint_step_from_name(entry.path().string());
-    if (s > best) {
-      best = s;
-      best_path = entry.path().string();
-    }
-  }
-  if (best < 0) return std::nullopt;
-  return best_path;
+  const std::vector<std::string> all = checkpoints_newest_first(run_dir);
+  if (all.empty()) return std::nullopt;
+  return all.front();
 }
 
+namespace {
+constexpr const char* kSealMagic = "NERAFCKP";
+constexpr uint32_t kSealVersion = 1;
+std::string first_line(const std::string& s) { return s.substr(0, s.find('\n')); }
+}  // namespace
+
 void save_archive(torch::serialize::OutputArchive& archive, const std::string& path) {
-  io::write_atomically(path, [&](const std::string& tmp) {
-    try {
-      archive.save_to(tmp);
-    } catch (const c10::Error& e) {
-      throw Error(path +
-                  ": cannot write the checkpoint (disk full or not writable?); free space "
-                  "or choose another --out");
-    }
-  });
+  // Serialised in memory and written by neraf (not LibTorch's writer, whose errors, e.g. a full
+  // disk, escape as std::terminate), sealed with a checksum so that changed bytes are detected.
+  std::ostringstream payload;
+  try {
+    archive.save_to(payload);
+  } catch (const std::exception& e) {
+    throw Error(path + ": cannot serialise the checkpoint (" + first_line(e.what()) + ")");
+  }
+  io::write_text_atomically(path, io::seal(kSealMagic, kSealVersion, payload.str()));
+}
+
+std::string checkpoint_damage(const std::string& path) {
+  try {
+    const std::string file = io::read_text_file(path);
+    if (io::has_magic(file, "PK\x03\x04")) return "";  // unsealed (before seals): cannot tell
+    io::unseal(file, kSealMagic, kSealVersion, path);
+    return "";
+  } catch (const Error& e) {
+    return e.what();
+  }
 }
 
 void load_archive(torch::serialize::InputArchive& archive, const std::string& path) {
   std::error_code ec;
   require(fs::is_regular_file(path, ec), path + ": no such checkpoint file; check the run folder");
+  const std::string file = io::read_text_file(path);
+  const std::string fix = "; delete it to resume from the previous checkpoint";
   try {
-    archive.load_from(path);
-  } catch (const c10::Error&) {
-    throw Error(path +
-                ": not a readable neraf checkpoint (truncated or corrupted); delete it to "
-                "resume from the previous checkpoint");
+    if (io::has_magic(file, "PK\x03\x04")) {  // a zip archive: written before checkpoints were sealed
+      archive.load_from(file.data(), file.size());
+      return;
+    }
+    require(io::has_magic(file, kSealMagic),
+            path + ": not a neraf checkpoint (unknown format); point at a file written by "
+                   "neraf train");
+    const io::Unsealed sealed = io::unseal(file, kSealMagic, kSealVersion, path);
+    archive.load_from(sealed.payload.data(), sealed.payload.size());
+  } catch (const Error& e) {
+    throw Error(e.what() + fix);
+  } catch (const std::exception&) {
+    throw Error(path + ": not a readable neraf checkpoint (truncated or corrupted)" + fix);
   }
+}
+
+std::vector<std::string> checkpoints_newest_first(const std::string& run_dir) {
+  std::vector<std::pair<int64_t, std::string>> found;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(checkpoint_dir(run_dir), ec)) {
+    if (!entry.is_regular_file()) continue;
+    const int64_t s = checkpoint_step_from_name(entry.path().string());
+    if (s >= 0) found.emplace_back(s, entry.path().string());
+  }
+  std::sort(found.rbegin(), found.rend());
+  std::vector<std::string> out;
+  for (auto& f : found) out.push_back(std::move(f.second));
+  return out;
+}
+
+std::string calibration_path(const std::string& checkpoint) {
+  const fs::path p(checkpoint);
+  return (p.parent_path() / (p.stem().string() + ".calibration.pt")).string();
+}
+
+int prune_checkpoints(const std::string& run_dir, int keep) {
+  if (keep <= 0) return 0;
+  const std::vector<std::string> all = checkpoints_newest_first(run_dir);
+  int removed = 0;
+  std::error_code ec;
+  for (size_t i = static_cast<size_t>(keep); i < all.size(); ++i) {
+    fs::remove(calibration_path(all[i]), ec);
+    if (fs::remove(all[i], ec)) ++removed;
+  }
+  return removed;
 }
 
 void load_module(torch::nn::Module& module, torch::serialize::InputArchive& archive,

@@ -1,6 +1,8 @@
 #pragma once
-// Checkpoint files: LibTorch archives written atomically (temporary file + rename), named
-// RUN/checkpoints/step-XXXXXXXXX.pt (9-digit step, so names sort by step). The trainer writes
+// Checkpoint files: LibTorch archives sealed with a checksum (io/sealed_file.h, magic
+// "NERAFCKP") and written durably and atomically (temporary file, fsync, rename), named
+// RUN/checkpoints/step-XXXXXXXXX.pt (9-digit step, so names sort by step); the energy
+// calibration fitted for one sits beside it as step-XXXXXXXXX.calibration.pt. The trainer writes
 // them (train/trainer.h); reading them (the header check, modules) is here, for loading a run.
 #include <torch/nn/module.h>
 #include <torch/serialize/input-archive.h>
@@ -10,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "neraf/infer/train_config.h"
 
@@ -22,13 +25,24 @@ std::string checkpoint_dir(const std::string& run_dir);                 // RUN/c
 std::string checkpoint_path(const std::string& run_dir, int64_t step);  // .../step-000001000.pt
 // The highest-step checkpoint in RUN/checkpoints, if any.
 std::optional<std::string> latest_checkpoint(const std::string& run_dir);
+// Every checkpoint in RUN/checkpoints, highest step first.
+std::vector<std::string> checkpoints_newest_first(const std::string& run_dir);
+// Deletes all but the `keep` newest checkpoints (and their calibrations); keep ≤ 0 keeps all.
+// Returns how many were deleted.
+int prune_checkpoints(const std::string& run_dir, int keep);
+// The calibration file of a checkpoint: step-XXXXXXXXX.calibration.pt beside it.
+std::string calibration_path(const std::string& checkpoint);
 // The step encoded in a checkpoint file name (−1 when the name does not follow the pattern).
 int64_t checkpoint_step_from_name(const std::string& path);
 
 // Writes `archive` to `path` atomically (the parent folder is created).
 void save_archive(torch::serialize::OutputArchive& archive, const std::string& path);
-// Reads an archive; a missing, truncated or corrupted file is a neraf::Error naming it.
+// Reads an archive; a missing, truncated, foreign or damaged (checksum) file is a neraf::Error
+// naming it. Unsealed archives (written before checksums) still load.
 void load_archive(torch::serialize::InputArchive& archive, const std::string& path);
+// "" when the file's seal is intact, else why not (truncated, damaged, ...), without parsing
+// the archive (resume falls back past damaged checkpoints with this).
+std::string checkpoint_damage(const std::string& path);
 
 // module.load(archive), plus what LibTorch does not check: every parameter and buffer keeps its
 // shape (LibTorch would silently resize them). neraf::Error naming `where` on any mismatch.

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "neraf/io/atomic_file.h"
 #include "neraf/neraf_rt.h"
 #include "neraf/util/error.h"
 
@@ -129,8 +130,12 @@ ExportReport export_model(const AudioRun& run, const std::string& path,
                           const ExportOptions& options, int64_t check_poses) {
   const rt::ModelData data = export_model_data(run, options);
   // Written and checked under a temporary name beside `path`, then renamed over it: a failed
-  // check leaves whatever was at `path` untouched.
-  const std::string candidate = path + ".check-" + std::to_string(static_cast<long long>(getpid()));
+  // check leaves whatever was at `path` untouched (and a killed export's file is removed by the
+  // next one, io/atomic_file.h).
+  io::require_replaceable_file(path);
+  const fs::path folder = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : ".";
+  io::remove_stale_temporaries(folder.string());
+  const std::string candidate = path + ".tmp-" + std::to_string(static_cast<long long>(getpid()));
   try {
     rt::write_model_file(candidate, data);
   } catch (const std::exception& e) {
@@ -173,6 +178,7 @@ ExportReport export_model(const AudioRun& run, const std::string& path,
               "); not written. This is a neraf bug: please report it with the run's config.json");
   fs::rename(candidate, path, ec);
   require(!ec, path + ": cannot rename the checked model into place (" + ec.message() + ")");
+  io::sync_path(folder.string());
   return report;
 }
 

@@ -1,5 +1,6 @@
 #include "neraf/infer/run.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -101,6 +102,44 @@ nlohmann::json make_data_manifest(const data::ImageSet& images, const std::strin
           {"default_intrinsics", intrinsics_json(k0)},
           {"eval_intrinsics", eval_intr},
           {"eval_camera_to_world", eval_poses}};
+}
+
+void check_vision_run_data(const std::string& vision_run, const nlohmann::json& now) {
+  const std::string path = run_file(vision_run, "data.json");
+  std::error_code ec;
+  require(fs::is_regular_file(path, ec),
+          vision_run +
+              ": not a training run (no data.json); point --vision-run at a neraf train "
+              "--out folder");
+  const nlohmann::json was = io::read_json(path);
+  require(was.is_object() && was.value("format", "") == kManifestFormat,
+          path + ": not a neraf run data manifest; re-run neraf train");
+  const std::string their = was.value("data", std::string("?"));
+  const std::string ours = now.value("data", std::string("?"));
+  auto refuse = [&](const std::string& what) {
+    throw Error(vision_run + ": trained on " + their + ", not on --data " + ours + ": the " + what +
+                " do not match); pass the vision run trained on this dataset");
+  };
+  for (const char* key : {"num_train", "width", "height", "train_files"})
+    if (was.value(key, nlohmann::json()) != now.value(key, nlohmann::json())) refuse(key);
+  // The normalisation (cameras' mean, orientation, scale) is computed from the poses: two rooms
+  // with the same image names and sizes still differ here. Compared with a tolerance, as JSON
+  // round trips doubles only to their printed digits.
+  auto close = [](const nlohmann::json& a, const nlohmann::json& b) {
+    if (!a.is_number() || !b.is_number()) return false;
+    const double x = a.get<double>(), y = b.get<double>();
+    return std::abs(x - y) <= 1e-9 * std::max({1.0, std::abs(x), std::abs(y)});
+  };
+  const nlohmann::json& ws = was.value("world_scale", nlohmann::json());
+  if (!close(ws, now.value("world_scale", nlohmann::json()))) refuse("world_scale");
+  const nlohmann::json a = was.value("world_transform", nlohmann::json());
+  const nlohmann::json b = now.value("world_transform", nlohmann::json());
+  bool same = a.is_array() && b.is_array() && a.size() == b.size();
+  for (size_t r = 0; same && r < a.size(); ++r) {
+    same = a[r].is_array() && b[r].is_array() && a[r].size() == b[r].size();
+    for (size_t c = 0; same && c < a[r].size(); ++c) same = close(a[r][c], b[r][c]);
+  }
+  if (!same) refuse("the camera poses (world_transform)");
 }
 
 torch::Tensor manifest_eval_poses(const nlohmann::json& m) {

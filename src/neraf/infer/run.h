@@ -21,6 +21,12 @@ namespace neraf::infer {
 // The data manifest written to RUN/data.json.
 nlohmann::json make_data_manifest(const data::ImageSet& images, const std::string& data_dir);
 
+// neraf::Error naming `vision_run` when its RUN/data.json describes another dataset than
+// `data_manifest` (make_data_manifest of --data): other train images (names, count, size) or
+// another world normalisation. A frozen radiance field only describes the room it was trained
+// on; an audio run on another room's grid trains without complaint and learns nothing useful.
+void check_vision_run_data(const std::string& vision_run, const nlohmann::json& data_manifest);
+
 // A trained run, ready for rendering (model in eval mode on `device`).
 struct LoadedRun {
   std::string run_dir;

@@ -70,6 +70,11 @@ struct AudioConfig {
   // Highest frequency exponent of the mic/source position encoding (reference 8).
   double position_max_freq_exp = 8.0;
   std::string vision_run;  // modality audio: the finished vision run whose field is frozen
+  // The RIR feature cache (data::RirLoadOptions): its folder ("" = <dataset>/.neraf_cache,
+  // --cache-dir) and precision ("fp32", or "fp16": half the disk, features rounded to ~1e-3
+  // relative; --cache-precision). Recorded so resume, calibration and eval reuse the same cache.
+  std::string cache_dir;
+  std::string cache_precision = "fp32";
   // "audio_fields" group: NAcF + ResNet3D (+ the radiance field in joint mode), Adam eps 1e-15,
   // sine warm-up from 1e-8 over warmup_steps then log-linear decay (neraf-reference.md §2.3).
   ScheduleConfig schedule{1e-4, 1e-8, 1002000, 2000, 1e-8, "sine", 1e-15};
@@ -92,6 +97,8 @@ struct AudioConfig {
     v("relative_geometry", relative_geometry);
     v("position_max_freq_exp", position_max_freq_exp);
     v("vision_run", vision_run);
+    v("cache_dir", cache_dir);
+    v("cache_precision", cache_precision);
     v("schedule", schedule);
   }
 };

@@ -1,6 +1,10 @@
 #pragma once
-// Atomic output: every file neraf writes goes to "<path>.tmp-<pid>" first and is renamed over
-// <path> only when complete, so an interrupted run never leaves a half-written output behind.
+// Durable, atomic output. Every file neraf writes goes to "<path>.tmp-<pid>" in the target's
+// folder first; once complete it is fsync'ed, renamed over <path>, and the folder is fsync'ed,
+// so neither an interrupted run nor a power cut leaves a half-written output behind. Outputs made
+// of several files are built in a temporary folder and renamed into place the same way.
+// Only regular files (and, for folders, folders) are ever replaced: a symlink, FIFO or device
+// node at the output path is an error, never swapped for a file.
 #include <functional>
 #include <string>
 
@@ -10,8 +14,27 @@ namespace neraf::io {
 // If `write` throws, the temporary file is removed and the exception propagates.
 void write_atomically(const std::string& path, const std::function<void(const std::string&)>& write);
 
-// Writes `text` to `path` atomically.
+// Writes `text` (any bytes) to `path` atomically; a short write (disk full) is a neraf::Error.
 void write_text_atomically(const std::string& path, const std::string& text);
+
+// Builds the folder `dir` through write(tmp_dir) in a temporary folder beside it, fsyncs what
+// was written and renames it into place. An existing `dir` is an error unless it is empty or
+// `replace` is set (then the old folder is swapped out and deleted only after the new one is in
+// place). If `write` throws, the temporary folder is removed and the exception propagates.
+void write_folder_atomically(const std::string& dir,
+                             const std::function<void(const std::string&)>& write,
+                             bool replace = false);
+
+// neraf::Error unless `path` is absent or a regular file (what write_atomically may replace).
+void require_replaceable_file(const std::string& path);
+
+// Removes the temporary files and folders ("*.tmp-<pid>") that processes which no longer exist
+// left in `folder` (a SIGKILL during a write); returns how many. Entries of live processes stay.
+int remove_stale_temporaries(const std::string& folder);
+
+// fsync of a file or folder (durability of its contents or of its entries); neraf::Error on
+// failure.
+void sync_path(const std::string& path);
 
 // Reads a whole file; throws neraf::Error naming the file when it is missing or unreadable.
 std::string read_text_file(const std::string& path);

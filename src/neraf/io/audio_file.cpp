@@ -60,31 +60,56 @@ bool data_chunk_truncated(SNDFILE* file, int64_t* declared, int64_t* actual) {
 
 }  // namespace
 
-AudioBuffer read_audio(const std::string& path) {
+namespace {
+
+// Opens `path` with the checks every reader shares; `info` gets the header.
+SndHandle open_checked(const std::string& path, SF_INFO& info, uintmax_t& bytes, bool& size_known) {
   std::error_code ec;
   require(fs::exists(path, ec), path + ": no such file; check the path");
   require(!fs::is_directory(path, ec), path + ": is a folder, expected an audio file");
-  const auto bytes = fs::file_size(path, ec);
-  require(ec || bytes > 0,
+  bytes = fs::file_size(path, ec);
+  size_known = !ec;
+  require(!size_known || bytes > 0,
           path + ": the file is empty (0 bytes); expected an audio file (WAV, FLAC, ...)");
-
-  SF_INFO info{};
+  info = SF_INFO{};
   SndHandle file(sf_open(path.c_str(), SFM_READ, &info));
   if (!file) {
     // sf_strerror(nullptr) reports why the last sf_open failed (unknown format, truncated
-    // header...).
+    // header, permission denied...).
     throw Error(path + ": not an audio file libsndfile can read (" + sf_strerror(nullptr) +
                 "); expected WAV, FLAC or another libsndfile format");
   }
   require(info.channels > 0, path + ": the audio file declares no channels; re-export it");
   require(info.samplerate > 0, path + ": the audio file declares no sample rate; re-export it");
-  require(info.frames > 0, path + ": the audio file is empty (0 frames); expected a recording");
   int64_t declared = 0, actual = 0;
   if (data_chunk_truncated(file.get(), &declared, &actual)) {
     throw Error(path + ": truncated audio file (its header announces " + std::to_string(declared) +
                 " bytes of samples, only " + std::to_string(actual) +
                 " are there); re-export or re-copy it");
   }
+  return file;
+}
+
+}  // namespace
+
+AudioFileInfo read_audio_info(const std::string& path) {
+  SF_INFO info{};
+  uintmax_t bytes = 0;
+  bool size_known = false;
+  const SndHandle file = open_checked(path, info, bytes, size_known);
+  AudioFileInfo out;
+  out.sample_rate = info.samplerate;
+  out.channels = info.channels;
+  out.frames = info.frames == SF_COUNT_MAX ? -1 : static_cast<int64_t>(info.frames);
+  return out;
+}
+
+AudioBuffer read_audio(const std::string& path) {
+  SF_INFO info{};
+  uintmax_t bytes = 0;
+  bool size_known = false;
+  SndHandle file = open_checked(path, info, bytes, size_known);
+  require(info.frames > 0, path + ": the audio file is empty (0 frames); expected a recording");
 
   // Float files are returned as stored; integer files are scaled to [-1, 1) by libsndfile (its
   // default normalisation).
@@ -97,7 +122,8 @@ AudioBuffer read_audio(const std::string& path) {
   // every real file needs at most) and grow with what is actually decoded.
   const bool length_known = info.frames != SF_COUNT_MAX;
   const sf_count_t size_bound =
-      ec ? kChunkFrames : static_cast<sf_count_t>(std::min<uintmax_t>(bytes, uintmax_t(1) << 40));
+      size_known ? static_cast<sf_count_t>(std::min<uintmax_t>(bytes, uintmax_t(1) << 40))
+                 : kChunkFrames;
   const sf_count_t reserve = std::min(info.frames, std::max(kChunkFrames, size_bound));
   out.channels.assign(nc, {});
   for (auto& ch : out.channels) ch.reserve(static_cast<size_t>(reserve));
@@ -109,6 +135,19 @@ AudioBuffer read_audio(const std::string& path) {
         length_known ? std::min(kChunkFrames, info.frames - done) : kChunkFrames;
     const sf_count_t got = sf_readf_float(file.get(), interleaved.data(), want);
     if (got <= 0) break;
+    for (sf_count_t i = 0; i < got * nc; ++i) {
+      // Checked here, once for every reader: a NaN or 1e30 sample poisons every STFT, metric and
+      // convolution computed from the file, far from where it came in.
+      const float v = interleaved[size_t(i)];
+      if (!std::isfinite(v) || std::abs(v) > kMaxAbsSample) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%g", static_cast<double>(v));
+        throw Error(path + ": sample " + std::to_string(done + i / nc) + " of channel " +
+                    std::to_string(i % nc) + " is " + buf +
+                    (std::isfinite(v) ? " (beyond ±1000, +60 dB over full scale)" : "") +
+                    "; the file is damaged, re-export it");
+      }
+    }
     for (int c = 0; c < nc; ++c) {
       std::vector<float>& ch = out.channels[c];
       for (sf_count_t i = 0; i < got; ++i) ch.push_back(interleaved[size_t(i) * nc + c]);

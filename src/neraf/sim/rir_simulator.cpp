@@ -6,6 +6,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "neraf/sim/scene_json.h"
 #include "neraf/util/error.h"
 
 namespace neraf::sim {
@@ -484,8 +485,9 @@ RirSimulator::RirSimulator(const Scene& scene, int sample_rate, const Hrtf* hrtf
   const Acoustics& ac = scene.acoustics;
   require(std::isfinite(ac.speed_of_sound) && ac.speed_of_sound > 1,
           "scene.json: acoustics.speed_of_sound must be a positive number of m/s (e.g. 343)");
-  require(ac.max_order >= 0 && ac.max_order <= 60,
-          "scene.json: acoustics.max_order must be in 0..60 (the image count grows as order³)");
+  require(ac.max_order >= 0 && ac.max_order <= kMaxReflectionOrder,
+          "scene.json: acoustics.max_order must be in 0.." + std::to_string(kMaxReflectionOrder) +
+              " (the image count grows as order³)");
   require(std::isfinite(ac.rir_length_s) && ac.rir_length_s > 0 && ac.rir_length_s <= 30,
           "scene.json: acoustics.rir_length_s must be in (0, 30] seconds");
   require(

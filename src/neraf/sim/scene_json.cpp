@@ -315,7 +315,7 @@ Scene scene_from_json(const json& j, const std::string& origin) {
     const std::string p = "acoustics";
     check_object(c, *m, p, {"speed_of_sound", "max_order", "rir_length_s"});
     opt(*m, "speed_of_sound", p, s.acoustics.speed_of_sound, number("a positive number (m/s)"));
-    opt(*m, "max_order", p, s.acoustics.max_order, integer("a whole number in [0, 100]"));
+    opt(*m, "max_order", p, s.acoustics.max_order, integer("a whole number in [0, 60]"));
     opt(*m, "rir_length_s", p, s.acoustics.rir_length_s, number("a number of seconds in (0, 20]"));
   }
 
@@ -355,6 +355,19 @@ void validate_scene(const Scene& s, const std::string& origin) {
   if (!(is_finite(s.size) && s.size.x > 0 && s.size.y > 0 && s.size.z > 0))
     fail(c, "size",
          std::string("must be ") + kThreePositive + " (room extent in metres along x, y (up), z)");
+  // Checked before anything walks the room: a 1e9 m room would otherwise make the camera and
+  // microphone placement, the textures and the reverb model work at absurd scales.
+  if (std::max({s.size.x, s.size.y, s.size.z}) > kMaxRoomSizeM)
+    fail(c, "size",
+         fmt(s.size) + " m: each side must be at most " + fmt(kMaxRoomSizeM) +
+             " m (the largest halls are ~300 m); use a smaller room");
+  // Every camera ray, shadow ray, microphone placement and sound path is tested against every
+  // box, so 20,000 boxes would run for hours; refused before any of that starts.
+  if (s.furniture.size() > kMaxFurniture)
+    fail(c, "furniture",
+         std::to_string(s.furniture.size()) + " boxes: at most " + std::to_string(kMaxFurniture) +
+             " (each camera ray and sound path is tested against every box); merge or remove "
+             "boxes");
   const std::string room = "the room [0, " + fmt(s.size.x) + "] x [0, " + fmt(s.size.y) +
                            "] x [0, " + fmt(s.size.z) + "]";
 
@@ -463,24 +476,28 @@ void validate_scene(const Scene& s, const std::string& origin) {
         return usable < 0 ? 0.0 : std::floor(usable / g.spacing_m + 1e-9) + 1;
       };
       const double grid_count = axis_count(s.size.x) * axis_count(s.size.z);
-      if (grid_count > 1000000)
+      if (grid_count > kMaxGridMicrophones)
         fail(c, p + ".spacing_m",
-             "gives " + fmt(grid_count) + " grid points; use a larger spacing");
+             fmt(g.spacing_m) + " m gives " + fmt(grid_count) + " grid points in a " +
+                 fmt(s.size.x) + " x " + fmt(s.size.z) + " m room (the limit is " +
+                 std::to_string(kMaxGridMicrophones) + "); use a larger spacing");
       const auto points = grid_microphone_positions(s);
       if (points.empty())
         fail(c, p,
              "no grid point is in free space (all inside furniture); move furniture or change "
              "spacing_m");
-      if (points.size() > 1000000)
+      if (points.size() > static_cast<size_t>(kMaxGridMicrophones))
         fail(c, p + ".spacing_m",
-             "gives " + std::to_string(points.size()) + " points; use a larger spacing");
+             "gives " + std::to_string(points.size()) + " points (the limit is " +
+                 std::to_string(kMaxGridMicrophones) + "); use a larger spacing");
     }
   }
   {
     const auto& r = mic.random;
     const std::string p = "microphones.random";
-    if (!(r.count >= 1 && r.count <= 1000000))
-      fail(c, p + ".count", "must be a whole number in [1, 1000000]");
+    if (!(r.count >= 1 && r.count <= kMaxGridMicrophones))
+      fail(c, p + ".count",
+           "must be a whole number in [1, " + std::to_string(kMaxGridMicrophones) + "]");
     if (!(r.wall_margin_m >= 0 && std::isfinite(r.wall_margin_m)))
       fail(c, p + ".wall_margin_m", "must be a number >= 0 (metres)");
     check_height_range(c, s, r.min_height_m, r.max_height_m, p);
@@ -524,8 +541,10 @@ void validate_scene(const Scene& s, const std::string& origin) {
   const auto& ac = s.acoustics;
   if (!(ac.speed_of_sound > 0 && std::isfinite(ac.speed_of_sound)))
     fail(c, "acoustics.speed_of_sound", "must be a positive number (m/s)");
-  if (!(ac.max_order >= 0 && ac.max_order <= 100))
-    fail(c, "acoustics.max_order", "must be a whole number in [0, 100]");
+  // The simulator's own limit (rir_simulator.cpp): the image count grows as order^3.
+  if (!(ac.max_order >= 0 && ac.max_order <= kMaxReflectionOrder))
+    fail(c, "acoustics.max_order",
+         "must be a whole number in [0, " + std::to_string(kMaxReflectionOrder) + "]");
   if (!(ac.rir_length_s > 0 && ac.rir_length_s <= 20))
     fail(c, "acoustics.rir_length_s", "must be a number of seconds in (0, 20]");
 }

@@ -38,4 +38,13 @@ bool inside_room(const Scene& scene, Vec3 p, double clearance = 0.0);
 // Minimum distance of sources, microphones, cameras and the light to the room's surfaces.
 constexpr double kSurfaceClearanceM = 0.05;
 
+// Limits validate_scene enforces before any work (docs/SCENE_FORMAT.md): the longest room side,
+// the furniture boxes, the microphone positions (grid points or random count) and the image-source
+// order (the simulator's, rir_simulator.cpp). The dataset's total size is checked separately
+// (check_synthesis_size, synthesize.h).
+constexpr double kMaxRoomSizeM = 1000;
+constexpr size_t kMaxFurniture = 1000;
+constexpr int kMaxGridMicrophones = 1000000;
+constexpr int kMaxReflectionOrder = 60;
+
 }  // namespace neraf::sim

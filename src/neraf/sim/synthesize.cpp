@@ -39,7 +39,8 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-void prepare_out_dir(const std::string& dir, bool force) {
+// The folder itself is built in a temporary folder and renamed into place (synthesize).
+void check_out_dir(const std::string& dir, bool force) {
   require(!dir.empty(), "--out: no output folder given; pass --out DIR");
   std::error_code ec;
   if (fs::exists(dir, ec)) {
@@ -48,10 +49,8 @@ void prepare_out_dir(const std::string& dir, bool force) {
     require(empty || force,
             dir +
                 ": the folder is not empty; choose a new or empty --out folder, or pass "
-                "--force to overwrite the files in it");
+                "--force to replace it");
   }
-  fs::create_directories(dir, ec);
-  require(!ec, dir + ": cannot create the folder (" + ec.message() + "); choose a writable --out");
 }
 
 // Runs body(i) for i in [0, n) on all OpenMP threads (dynamic schedule) with a progress bar drawn
@@ -78,20 +77,14 @@ void parallel_for_with_progress(int64_t n, Progress* progress, Body body) {
   if (error) std::rethrow_exception(error);
 }
 
-}  // namespace
-
-SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
-  const auto t_start = std::chrono::steady_clock::now();
-  validate_scene(scene, "scene \"" + scene.name + "\"");
-  const SynthPlan plan = plan_synthesis(scene, options.layout, options.seed);
-  prepare_out_dir(options.out_dir, options.force);
-  const fs::path root(options.out_dir);
+// Writes the whole dataset of `plan` into the folder `root`.
+SynthSummary write_dataset(const Scene& scene, const SynthOptions& options, const SynthPlan& plan,
+                           const fs::path& root) {
   const auto out = [&](const std::string& rel) { return (root / rel).string(); };
   const bool soundspaces = plan.layout == "soundspaces";
 
   SynthSummary sum;
   sum.layout = plan.layout;
-  sum.out_dir = options.out_dir;
   sum.sample_rate = plan.sample_rate;
   sum.channels = plan.binaural ? 2 : 1;
   sum.num_microphones = static_cast<int>(plan.microphones.size());
@@ -267,6 +260,24 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
                {"eyring_t60_s", t60}};
   if (plan.binaural) info["hrtf"] = hrtf->path();
   io::write_json_atomically(out("synth_info.json"), info);
+  return sum;
+}
+
+}  // namespace
+
+SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
+  const auto t_start = std::chrono::steady_clock::now();
+  validate_scene(scene, "scene \"" + scene.name + "\"");
+  check_synthesis_size(scene, options.layout, "scene \"" + scene.name + "\"");
+  const SynthPlan plan = plan_synthesis(scene, options.layout, options.seed);
+  check_out_dir(options.out_dir, options.force);
+  // A failure (bad HRTF, full disk, Ctrl-C) leaves no half-written dataset behind.
+  SynthSummary sum;
+  io::write_folder_atomically(
+      options.out_dir,
+      [&](const std::string& tmp) { sum = write_dataset(scene, options, plan, tmp); },
+      options.force);
+  sum.out_dir = options.out_dir;
   sum.total_seconds = seconds_since(t_start);
   return sum;
 }

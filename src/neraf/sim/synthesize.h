@@ -24,7 +24,7 @@ struct SynthOptions {
   std::string layout = "soundspaces";  // "soundspaces" | "raf"
   std::string out_dir;
   uint64_t seed = 0;
-  bool force = false;     // write into a non-empty out_dir (files are replaced atomically)
+  bool force = false;     // replace a non-empty out_dir (only once the new dataset is complete)
   bool progress = true;   // progress bars on stderr
   std::string hrtf_path;  // SOFA file for binaural RIRs; empty: Hrtf::kDefaultSofa
   // > 0: every RIR is scaled by this instead of the automatic gain (which puts the set's peak at
@@ -55,6 +55,31 @@ struct SynthPlan {
 // unknown layout.
 SynthPlan plan_synthesis(const Scene& scene, const std::string& layout, uint64_t seed);
 
+// How big a dataset is, from the scene's counts alone (no plan, no positions beyond the grid's),
+// so an absurd request fails before any memory is allocated or file written.
+struct SynthSize {
+  int64_t microphones = 0, headings = 1, sources = 0, rirs = 0;
+  int channels = 1;
+  int64_t samples_per_rir = 0;
+  int64_t images = 0;
+  double rir_bytes = 0;    // float WAVs
+  double image_bytes = 0;  // raw RGB (an upper bound of the PNGs)
+  double total_bytes() const { return rir_bytes + image_bytes; }
+};
+SynthSize estimate_synthesis(const Scene& scene, const std::string& layout);
+
+// The largest dataset `neraf synth` writes: SoundSpaces' biggest scene (apartment_1) has ~124k
+// binaural RIRs of ~44 GB; beyond these a typo (a million microphones) would fill the disk for
+// hours before failing.
+constexpr int64_t kMaxSynthRirs = 250000;
+constexpr double kMaxSynthBytes = 64e9;
+
+// Throws neraf::Error (one line: `origin`, the counts, the estimated size and the limits) when the
+// dataset exceeds kMaxSynthRirs or kMaxSynthBytes. `count_flags` names the flags that set the
+// counts (e.g. "--mic-count"), for the fix.
+void check_synthesis_size(const Scene& scene, const std::string& layout, const std::string& origin,
+                          const std::string& count_flags = "");
+
 struct SynthSummary {
   std::string layout, out_dir;
   int sample_rate = 0, channels = 0;
@@ -66,7 +91,8 @@ struct SynthSummary {
   double image_seconds = 0, rir_seconds = 0, total_seconds = 0;
 };
 
-// Writes the dataset. Refuses a non-empty out_dir unless options.force. Every RIR is scaled by one
+// Writes the dataset, built in a temporary folder beside out_dir and renamed into place (a failure
+// leaves nothing). Refuses a non-empty out_dir unless options.force. Every RIR is scaled by one
 // scene-wide gain = min(1, 0.5 / peak of the closest source-microphone pairs) so no sample clips
 // in NeRAF's loaders (which clip to [-1, 1]) and relative levels stay physical; the gain is
 // recorded in synth_info.json.

@@ -154,63 +154,6 @@ LossDict AudioBranch::losses(StepContext& ctx) {
   return out;
 }
 
-torch::Tensor AudioBranch::energy_calibration() {
-  const int64_t C = rirs_.channels, F = rirs_.n_freq, T = rirs_.max_len;
-  if (!config_.audio.energy_calibration) return torch::ones({C, F, T});
-  torch::NoGradGuard no_grad;
-  const bool was_training = model_->is_training();
-  model_->eval();
-  const torch::Tensor feature = model_->scene_feature(grid_->grid().detach());  // [G] or none
-  const int64_t n = static_cast<int64_t>(train_rirs_.size());
-  const int64_t stride = std::max<int64_t>(1, (n + 511) / 512);  // at most 512 RIRs
-  const int64_t sampled = (n + stride - 1) / stride;
-  const int64_t balance_stride = std::max<int64_t>(1, (sampled + 63) / 64);  // ≤ 64 of those
-  torch::Tensor gt_energy = torch::zeros({C, F, T}, torch::kFloat64),
-                pred_energy = gt_energy.clone();
-  std::vector<std::pair<int64_t, torch::Tensor>> preds;  // (RIR, [C, F, T]) for the balance
-  for (int64_t k = 0; k < n; k += stride) {
-    const int64_t i = train_rirs_[static_cast<size_t>(k)];
-    const torch::Tensor idx = torch::tensor({i}, torch::kInt64);
-    const torch::Tensor mic =
-        data::normalize_position(rirs_.mic_positions.index_select(0, idx), rirs_.audio_aabb);
-    const torch::Tensor src =
-        data::normalize_position(rirs_.source_positions.index_select(0, idx), rirs_.audio_aabb);
-    const torch::Tensor pred = model_->render_stft_with_feature(
-        feature, mic.to(device_), src.to(device_), rirs_.rots[i].to(device_));  // [C, F, T]
-    pred_energy += acoustic::bin_energy(pred.cpu());
-    gt_energy += acoustic::bin_energy(rirs_.features(i));
-    if ((k / stride) % balance_stride == 0) preds.emplace_back(i, pred.cpu());
-  }
-  model_->train(was_training);
-  const torch::Tensor gain = acoustic::calibration_gain(gt_energy, pred_energy);
-
-  // Early/late balance: C50 of the calibrated predictions rendered as evaluation renders them
-  // (Griffin-Lim, seeded) against the training waveforms, per channel (calibration.h).
-  const double fs = rirs_.sample_rate;
-  torch::Tensor delta = torch::zeros({C}, torch::kFloat64);
-  std::vector<int64_t> counted(static_cast<size_t>(C), 0);
-  for (size_t r = 0; r < preds.size(); ++r) {
-    const auto& [i, pred] = preds[r];
-    const torch::Tensor gt = rirs_.waveform(i).contiguous();  // [C, L]
-    const auto wave = infer::griffin_lim_channels(
-        infer::log_stft_to_magnitude(acoustic::apply_calibration(pred, gain)), rirs_.stft,
-        config_.seed + r, gt.size(1));
-    for (int64_t c = 0; c < C; ++c) {
-      const float* g = gt[c].data_ptr<float>();
-      const double d = metrics::measure_c50(std::vector<float>(g, g + gt.size(1)), fs) -
-                       metrics::measure_c50(wave[static_cast<size_t>(c)], fs);
-      if (!std::isfinite(d)) continue;
-      delta[c] += d;
-      ++counted[static_cast<size_t>(c)];
-    }
-  }
-  for (int64_t c = 0; c < C; ++c)
-    if (counted[static_cast<size_t>(c)] > 0)
-      delta[c] /= static_cast<double>(counted[static_cast<size_t>(c)]);
-  return acoustic::with_early_balance(gain, delta, rirs_.stft.hop_length,
-                                      metrics::c50_split_sample(fs));
-}
-
 void AudioBranch::save(torch::serialize::OutputArchive& archive) {
   torch::serialize::OutputArchive m, g;
   model_->save(m);
@@ -224,7 +167,6 @@ void AudioBranch::save(torch::serialize::OutputArchive& archive) {
   archive.write("cursor", torch::tensor(cursor_, torch::kInt64));
   archive.write("manifest", c10::IValue(infer::make_audio_manifest(rirs_).dump()));
   archive.write("train_rirs", torch::tensor(train_rirs_, torch::kInt64));
-  archive.write("calibration", energy_calibration());
 }
 
 void AudioBranch::load(torch::serialize::InputArchive& archive, const std::string& where) {

@@ -46,8 +46,8 @@ class AudioBranch : public Branch {
   LossDict losses(StepContext& ctx) override;
   void set_training(bool training) override;
   // Saves "model" (AcousticModel), "grid" (GridSampler: grid + pointer) and the data sampler
-  // ("perm", "cursor") so a killed run resumes exactly, and "calibration" (see below; used by
-  // inference only, recomputed at every save).
+  // ("perm", "cursor") so a killed run resumes exactly. (The energy calibration is a stage of
+  // its own after training: infer/calibration.h.)
   void save(torch::serialize::OutputArchive& archive) override;
   void load(torch::serialize::InputArchive& archive, const std::string& where) override;
 
@@ -56,9 +56,6 @@ class AudioBranch : public Branch {
   const std::vector<int64_t>& train_rirs() const { return train_rirs_; }
   // The radiance-field query the grid uses (density, rgb at u with train image 0's appearance).
   acoustic::FieldQueryFn field_query();
-  // [C, F, T] energy gains of the current model on (at most 512, evenly strided) train
-  // RIRs, acoustic/calibration.h; all ones when audio.energy_calibration is off.
-  torch::Tensor energy_calibration();
 
  private:
   // The step's (RIR index, frame) pairs, each [B + D·T] int64: batch_size slices (the uniform

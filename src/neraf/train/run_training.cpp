@@ -1,14 +1,18 @@
 #include "neraf/train/run_training.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <deque>
 #include <filesystem>
 #include <memory>
 
 #include "neraf/infer/audio_run.h"
+#include "neraf/infer/calibration.h"
 #include "neraf/infer/checkpoint.h"
 #include "neraf/infer/run.h"
+#include "neraf/io/atomic_file.h"
+#include "neraf/io/folder_lock.h"
 #include "neraf/io/json_file.h"
 #include "neraf/train/trainer.h"
 #include "neraf/util/error.h"
@@ -28,9 +32,36 @@ std::string run_file(const std::string& run_dir, const char* name) {
   return (fs::path(run_dir) / name).string();
 }
 
+// Anything but the folder's lock file (taken before this is asked).
 bool folder_has_entries(const fs::path& p) {
   std::error_code ec;
-  return fs::is_directory(p, ec) && fs::directory_iterator(p, ec) != fs::directory_iterator();
+  for (const auto& entry : fs::directory_iterator(p, ec))
+    if (entry.path().filename() != io::FolderLock::kFileName) return true;
+  return false;
+}
+
+// The newest checkpoint whose seal is intact; damaged ones are skipped with a warning (a disk
+// error, or bytes changed by hand), so a run resumes from the one before.
+std::optional<std::string> newest_intact_checkpoint(const std::string& run_dir) {
+  for (const std::string& path : infer::checkpoints_newest_first(run_dir)) {
+    const std::string damage = infer::checkpoint_damage(path);
+    if (damage.empty()) return path;
+    warn(damage + "; resuming from the previous checkpoint instead");
+  }
+  return std::nullopt;
+}
+
+// The calibration stage (infer/calibration.h) of a finished audio/joint run, unless done.
+void calibrate_if_needed(const TrainConfig& cfg, const std::string& run_dir,
+                         const std::string& checkpoint, int64_t step, const data::RirSet* rirs) {
+  if (cfg.modality == Modality::vision || !cfg.audio.energy_calibration || !rirs) return;
+  if (infer::load_calibration(checkpoint, step)) return;
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::string path = infer::calibrate_run(run_dir, *rirs, checkpoint);
+  info("calibrated the acoustic field on its training RIRs in " +
+       std::to_string(static_cast<int>(std::lround(
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()))) +
+       " s → " + path);
 }
 
 }  // namespace
@@ -42,6 +73,10 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
   TrainConfig cfg = config_in;
   std::optional<std::string> resume_from;
   nlohmann::json old_manifest;
+  // One writer per run folder; what a killed writer left half-written goes.
+  const io::FolderLock lock(options.run_dir);
+  io::remove_stale_temporaries(options.run_dir);
+  io::remove_stale_temporaries(infer::checkpoint_dir(options.run_dir));
 
   if (options.resume) {
     std::error_code ec;
@@ -53,7 +88,10 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
     if (options.steps) infer::set_run_length(cfg, *options.steps);
     if (options.threads) cfg.threads = *options.threads;
     if (fs::is_regular_file(manifest_path, ec)) old_manifest = io::read_json(manifest_path);
-    resume_from = infer::latest_checkpoint(options.run_dir);
+    const bool any = !infer::checkpoints_newest_first(options.run_dir).empty();
+    resume_from = newest_intact_checkpoint(options.run_dir);
+    require(resume_from || !any, options.run_dir +
+                                     ": every checkpoint is damaged; start over with --force");
     if (!resume_from) warn(options.run_dir + ": no checkpoint yet; starting from step 0");
   } else if (folder_has_entries(run)) {
     require(options.force, options.run_dir +
@@ -64,6 +102,7 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
     fs::remove(config_path, ec);
     fs::remove(manifest_path, ec);
   }
+  if (options.save_every) cfg.save_every = *options.save_every;
   infer::validate(cfg, "config");
   if (cfg.threads > 0) torch::set_num_threads(cfg.threads);
   torch::manual_seed(cfg.seed);  // anything that still draws from the global generator
@@ -73,6 +112,8 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
   require(!data_dir.empty(), "--data: required (the dataset folder or its transforms.json)");
   const data::ImageSet images = data::load_transforms_json(data_dir);
   nlohmann::json manifest = infer::make_data_manifest(images, data_dir);
+  if (cfg.modality == Modality::audio)
+    infer::check_vision_run_data(cfg.audio.vision_run, manifest);  // not another room's field
   if (!old_manifest.is_null() && resume_from) {
     for (const char* key : {"num_train", "height", "width", "train_files"})
       require(old_manifest.value(key, nlohmann::json()) == manifest[key],
@@ -84,6 +125,9 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
   if (cfg.modality != Modality::vision) {
     data::RirLoadOptions rload;
     rload.progress = options.progress;
+    rload.stop = options.stop;  // Ctrl-C stops a feature-cache build too
+    rload.cache_dir = cfg.audio.cache_dir;  // --cache-dir, --cache-precision (recorded in config)
+    rload.half_precision = data::parse_cache_precision(cfg.audio.cache_precision);
     rirs = std::make_unique<data::RirSet>(data::load_rir_set(data_dir, rload));
     if (!old_manifest.is_null() && resume_from && old_manifest.contains("audio"))
       infer::check_audio_manifest(old_manifest["audio"], *rirs, data_dir);
@@ -106,7 +150,10 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
   if (summary.start_step >= cfg.steps) {
     info(options.run_dir + ": already trained to step " + std::to_string(summary.start_step) +
          "; pass --steps N to train further");
-    if (resume_from) summary.checkpoint = *resume_from;
+    if (resume_from) {
+      summary.checkpoint = *resume_from;
+      calibrate_if_needed(cfg, options.run_dir, *resume_from, summary.start_step, rirs.get());
+    }
     return summary;
   }
 
@@ -121,7 +168,19 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
   double psnr_sum = 0, audio_decay = 0;
   int64_t rays = 0;
   for (;;) {
-    const StepResult r = trainer->step();
+    StepResult r;
+    try {
+      r = trainer->step();
+    } catch (const DivergedError& e) {
+      progress.finish();
+      throw Error(std::string(e.what()) + "; " +
+                  (summary.checkpoint.empty() && !resume_from
+                       ? "no checkpoint was written yet"
+                       : "the last checkpoint, " +
+                             (summary.checkpoint.empty() ? *resume_from : summary.checkpoint) +
+                             ", is kept") +
+                  "; start over with another --seed, or change the run's settings");
+    }
     rays += r.rays;
     summary.end_step = r.step;
     summary.last_loss = r.loss;
@@ -164,6 +223,7 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
     if (done || stop || r.step % cfg.save_every == 0) {
       summary.checkpoint = infer::checkpoint_path(options.run_dir, r.step);
       trainer->save_checkpoint(summary.checkpoint);
+      infer::prune_checkpoints(options.run_dir, options.keep);
     }
     if (stop) {
       summary.interrupted = true;
@@ -172,9 +232,12 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
     if (done) break;
   }
   progress.finish();
-  if (summary.interrupted)
+  if (summary.interrupted) {
     info("interrupted: checkpoint saved at step " + std::to_string(summary.end_step) +
          "; continue with --resume");
+    return summary;
+  }
+  calibrate_if_needed(cfg, options.run_dir, summary.checkpoint, summary.end_step, rirs.get());
   return summary;
 }
 

@@ -19,6 +19,8 @@ struct TrainRunOptions {
   bool force = false;            // start over in a non-empty run_dir (its checkpoints are deleted)
   std::optional<int64_t> steps;  // on resume: a new total step count
   std::optional<int> threads;    // on resume: a different thread count (numbers then differ)
+  std::optional<int64_t> save_every;  // a checkpoint every N steps (default: the preset's)
+  int keep = 3;                       // checkpoints kept (the newest); 0 keeps all
   bool progress = true;
   const std::atomic<bool>* stop = nullptr;  // set asynchronously (Ctrl-C) → checkpoint and return
   torch::Device device = torch::kCPU;
@@ -36,8 +38,12 @@ struct TrainRunSummary {
   std::string checkpoint;  // the last checkpoint written
 };
 
-// Trains `config` (already resolved from preset + flags) into options.run_dir. On resume the
-// run's own config.json is used instead (options.steps/threads may override those two).
+// Trains `config` (already resolved from preset + flags) into options.run_dir, holding its lock
+// (io/folder_lock.h: a second writer is refused), then calibrates the acoustic field
+// (infer/calibration.h) unless interrupted. On resume the run's own config.json is used instead
+// (options.steps/threads may override those two) and a damaged latest checkpoint is skipped
+// for the one before. A diverged loss (NaN/Inf) stops with neraf::Error naming the term; the
+// last checkpoint stays.
 TrainRunSummary run_training(const infer::TrainConfig& config, const TrainRunOptions& options);
 
 }  // namespace neraf::train

@@ -168,10 +168,16 @@ StepResult Trainer::step() {
   }
   if (!all.empty()) {
     torch::Tensor total = torch::zeros({}, all.begin()->second.options());
-    for (const auto& [k, v] : all) total = total + v;
+    for (const auto& [k, v] : all) {
+      total = total + v;
+      result.losses[k] = v.item<double>();
+      if (!std::isfinite(result.losses[k]))
+        throw DivergedError("step " + std::to_string(step_ + 1) + ": the loss term '" + k +
+                            "' is " + (std::isnan(result.losses[k]) ? "NaN" : "infinite") +
+                            " (training diverged)");
+    }
     if (total.requires_grad()) total.backward();
     for (auto& g : groups_) g.optimizer->step();
-    for (const auto& [k, v] : all) result.losses[k] = v.item<double>();
     result.loss = total.item<double>();
   }
   result.step = ++step_;
@@ -180,6 +186,11 @@ StepResult Trainer::step() {
 
 void Trainer::save_checkpoint(const std::string& path) {
   if (groups_.empty()) build_optimizers();
+  for (const auto& g : groups_)
+    for (const auto& p : g.params)
+      if (!torch::isfinite(p).all().item<bool>())
+        throw DivergedError("step " + std::to_string(step_) + ": weights of '" + g.name +
+                            "' are not finite (training diverged); not saving " + path);
   torch::serialize::OutputArchive a;
   a.write("format", c10::IValue(std::string(infer::kCheckpointFormat)));
   a.write("config", c10::IValue(to_json(config_).dump()));

@@ -26,6 +26,7 @@
 #include "neraf/data/rir_set.h"
 #include "neraf/infer/train_config.h"
 #include "neraf/nerf/nerfacto_model.h"
+#include "neraf/util/error.h"
 
 namespace neraf::train {
 
@@ -91,6 +92,13 @@ class VisionBranch : public Branch {
   int64_t steps_since_update_ = 0;
 };
 
+// Training diverged: a loss term came out NaN or infinite (the step is not applied), or the
+// weights to be saved are not finite (nothing is written). run_training keeps the last
+// checkpoint, whose weights were finite.
+struct DivergedError : Error {
+  using Error::Error;
+};
+
 struct StepResult {
   int64_t step = 0;                       // steps completed after this one
   std::map<std::string, double> losses;   // each named loss
@@ -107,13 +115,15 @@ class Trainer {
   void add_branch(std::unique_ptr<Branch> branch);
 
   // One optimisation step: LRs from the schedules, zero grads, every branch's losses, backward,
-  // every optimizer steps.
+  // every optimizer steps. DivergedError naming the term when a loss is not finite (nothing is
+  // applied then).
   StepResult step();
   int64_t completed_steps() const { return step_; }
 
   // Archive layout: "format", "config" (resolved JSON), "step", "rng", "branch/<name>",
   // "optim/<group>". Loading checks that the stored config describes the same model (preset,
   // model, modality) and throws neraf::Error naming the file and the first differing setting.
+  // DivergedError (nothing written) when a parameter is not finite.
   void save_checkpoint(const std::string& path);
   void load_checkpoint(const std::string& path);
 

@@ -1,0 +1,64 @@
+// `neraf calibrate`: the calibration stage of a run on its own (infer/calibration.h). Training
+// runs it at its end; a run stopped before (Ctrl-C, a kill) or an older checkpoint is
+// calibrated with this.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <string>
+
+#include "neraf/cli/commands.h"
+#include "neraf/data/rir_set.h"
+#include "neraf/infer/calibration.h"
+#include "neraf/infer/run.h"
+#include "neraf/io/folder_lock.h"
+#include "neraf/io/json_file.h"
+#include "neraf/util/error.h"
+
+namespace neraf::cli {
+namespace {
+
+struct CalibrateArgs {
+  std::string run_dir;
+  std::string data;
+  std::string checkpoint;
+  bool quiet = false;
+};
+
+void run_calibrate(const CalibrateArgs& args) {
+  const io::FolderLock lock(args.run_dir);  // not while training writes the run
+  const std::string manifest_path = args.run_dir + "/data.json";
+  const nlohmann::json manifest = io::read_json(manifest_path);
+  require(manifest.contains("audio") && manifest.contains("data"),
+          manifest_path + ": no audio dataset in this run (trained with --modality vision)");
+  data::RirLoadOptions load;
+  load.progress = !args.quiet;
+  const std::string data_dir = args.data.empty() ? manifest["data"].get<std::string>() : args.data;
+  const data::RirSet rirs = data::load_rir_set(data_dir, load);
+  const std::string path = infer::calibrate_run(args.run_dir, rirs, args.checkpoint);
+  std::printf("wrote %s\n", path.c_str());
+}
+
+}  // namespace
+
+void register_calibrate(CLI::App& app) {
+  auto args = std::make_shared<CalibrateArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "calibrate",
+      "Fit a run's energy calibration on its training RIRs (training does this at its end; use "
+      "it for a run stopped before, or for an older --checkpoint)");
+  cmd->add_option("--run", args->run_dir, "trained run folder (neraf train --out)")
+      ->required()
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("--data", args->data,
+                  "the run's dataset, if it moved (default: the folder recorded in RUN/data.json)")
+      ->check(CLI::ExistingDirectory);
+  cmd->add_option("--checkpoint", args->checkpoint,
+                  "a checkpoint file of the run (default: the latest)")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--quiet", args->quiet, "No progress bar");
+  cmd->footer(
+      "Writes RUN/checkpoints/step-XXXXXXXXX.calibration.pt beside the checkpoint.\n"
+      "Example: neraf calibrate --run runs/demo");
+  cmd->callback([args] { run_calibrate(*args); });
+}
+
+}  // namespace neraf::cli

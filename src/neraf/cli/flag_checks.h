@@ -1,0 +1,26 @@
+#pragma once
+// Checked ranges for the numeric flags of every subcommand (neraf/util/number_text.h does the
+// parsing): a value outside the range, a negative seed, NaN, 1e23 for an integer or any text that
+// is not a number is a usage error naming the flag and the range ("--steps: must be a whole number
+// in [1, 100000000]; got 99999999999999999999"), never a wrapped or clamped value. The range shows
+// in --help after the type ("INT:[1, 100000000]").
+#include <CLI/CLI.hpp>
+#include <cstdint>
+#include <limits>
+
+namespace neraf::cli {
+
+// Integer flags. Accepts "1e6" for 1000000 (it is handed on in plain decimal, so attach these
+// three with ->transform(): CLI11's ->check() gives a validator a copy of the text).
+CLI::Validator whole_number(int64_t lo, int64_t hi);
+// Seeds: any unsigned 64-bit value, written as a whole number.
+CLI::Validator seed_number(uint64_t hi = std::numeric_limits<uint64_t>::max());
+// Real flags: finite and in [lo, hi] ((lo, hi] when lo_open).
+CLI::Validator real_number(double lo, double hi, bool lo_open = false);
+// --threads: [1, max_thread_count()] (4 x the machine's hardware threads).
+CLI::Validator thread_count();
+
+// Most steps a training run may be asked for (the paper preset runs 400001).
+constexpr int64_t kMaxSteps = 100000000;
+
+}  // namespace neraf::cli

@@ -1,0 +1,32 @@
+#pragma once
+// The calibration stage: after training (run_training) or on demand (`neraf calibrate RUN`), the
+// energy calibration and early/late balance of a run's acoustic field (acoustic/calibration.h)
+// are fitted on its training RIRs and saved beside the checkpoint they belong to
+// (checkpoint.h, calibration_path: step-XXXXXXXXX.calibration.pt, a sealed archive holding
+// "step" and "gains"). Saving a checkpoint therefore stays fast and has no side effects.
+#include <torch/types.h>
+
+#include <optional>
+#include <string>
+
+#include "neraf/data/rir_set.h"
+#include "neraf/infer/audio_run.h"
+
+namespace neraf::infer {
+
+// [C, F, T] gains fitted for `run` (loaded uncalibrated) on the run's training RIRs of `rirs`
+// (its few-shot subset; at most 512 evenly strided for the energies, 64 of those rendered
+// through Griffin-Lim for the balance); all ones when the run has calibration off.
+torch::Tensor fit_calibration(const AudioRun& run, const data::RirSet& rirs);
+
+void save_calibration(const std::string& checkpoint, int64_t step, const torch::Tensor& gains);
+// The gains saved for `checkpoint` (nullopt when there are none); neraf::Error naming the file
+// when it is damaged or was fitted for another step.
+std::optional<torch::Tensor> load_calibration(const std::string& checkpoint, int64_t step);
+
+// Fits and saves the calibration of RUN's latest checkpoint (or `checkpoint`) on `rirs` (the
+// run's dataset); returns the calibration file written.
+std::string calibrate_run(const std::string& run_dir, const data::RirSet& rirs,
+                          const std::string& checkpoint = "");
+
+}  // namespace neraf::infer

@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# SIGKILL at random moments of a training run, then --resume, KILLS times; then the run finishes.
+# Every step writes a checkpoint (--save-every 1), so many kills land inside a checkpoint write.
+# Checks: every restart succeeds and never meets a damaged checkpoint, the orphaned temporary
+# files of a kill are gone after the next start, and the finished run renders exactly the RIR of
+# an uninterrupted run with the same seed and thread count (nothing lost, nothing changed).
+# Usage: kill_resume.sh <path to neraf> <assets dir> [KILLS (default 20)]
+set -u
+NERAF=$1
+ASSETS=$2
+KILLS=${3:-20}
+source "$(dirname "$0")/lib.sh"
+
+S=$TMP/scene R=$TMP/run
+expect_exit 0 "$NERAF" synth --preset demo --layout soundspaces --out "$S" --seed 3 --quiet
+settings=(--steps 40 --audio-start-step 2 --rays 256 --threads 1 --save-every 1 --keep 3 --quiet)
+new_run=(train --data "$S" --out "$R" "${settings[@]}")
+resume=(train --out "$R" --resume --threads 1 --save-every 1 --keep 3 --quiet)
+expect_exit 0 "$NERAF" train --data "$S" --out "$TMP/reference" "${settings[@]}"
+
+temporaries() { find "$R" -name '*.tmp-*' 2>/dev/null | wc -l; }
+RANDOM=12345  # the same kill times every run
+orphans=0 in_write=0 restarts=0 steps=() orphaned=() last_step=
+for ((k = 1; k <= KILLS; ++k)); do
+  if [ -f "$R/config.json" ]; then cmd=("${resume[@]}"); else cmd=("${new_run[@]}"); fi
+  "$NERAF" "${cmd[@]}" >"$TMP/out" 2>"$TMP/err" &
+  pid=$!
+  # 0.3–3.3 s: some kills hit start-up, most hit training steps and checkpoint writes.
+  sleep "$((RANDOM % 3)).$((RANDOM % 1000 + 300))"
+  if ! kill -0 "$pid" 2>/dev/null; then
+    wait "$pid"
+    echo "run finished before kill $k"
+    break
+  fi
+  kill -KILL "$pid"
+  wait "$pid" 2>/dev/null
+  ((++restarts))
+  grep -q "damaged" "$TMP/err" && fail "restart $k met a damaged checkpoint: $(cat "$TMP/err")"
+  grep -q "^error" "$TMP/err" && fail "restart $k failed: $(cat "$TMP/err")"
+  newest=$(find "$R/checkpoints" -name 'step-*[0-9].pt' 2>/dev/null | sort | tail -1)
+  step=${newest:+$((10#$(basename "$newest" .pt | cut -d- -f2)))}
+  # A restart that got as far as a new checkpoint was past its start-up, where it removes what
+  # the kill before it left.
+  if [ -n "$step" ] && [ "$step" != "$last_step" ]; then
+    for f in "${orphaned[@]}"; do
+      [ -e "$f" ] && fail "restart $k (now at step $step) left $f of the kill before it"
+    done
+  fi
+  steps+=("${step:-none}")
+  last_step=$step
+  mapfile -t orphaned < <(find "$R" -name '*.tmp-*' 2>/dev/null)
+  now=${#orphaned[@]}
+  orphans=$((orphans + now))
+  [ "$now" -gt 0 ] && ((++in_write))
+done
+# The last restart runs to the end (and calibrates).
+expect_exit 0 "$NERAF" "${resume[@]}"
+grep -q "damaged" "$TMP/err" && fail "the final resume met a damaged checkpoint: $(cat "$TMP/err")"
+[ "$(temporaries)" -eq 0 ] || fail "temporary files left after the final resume: $(find "$R" -name '*.tmp-*')"
+expect_file "$R/checkpoints/step-000000040.pt"
+expect_file "$R/checkpoints/step-000000040.calibration.pt"
+[ "$(find "$R/checkpoints" -name 'step-*[0-9].pt' | wc -l)" -le 3 ] || fail "more than --keep 3 checkpoints"
+
+for run in reference run; do
+  expect_exit 0 "$NERAF" render rir --run "$TMP/$run" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 --yaw 90 \
+    --out "$TMP/$run.wav"
+done
+cmp -s "$TMP/reference.wav" "$TMP/run.wav" ||
+  fail "the killed and resumed run renders another RIR than the uninterrupted one"
+echo "kill_resume: $restarts kills ($in_write during a checkpoint write, $orphans orphaned temporary" \
+  "files, all removed by the next start); newest checkpoint after each kill: ${steps[*]:-none}"
+finish kill_resume
