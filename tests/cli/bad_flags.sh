@@ -128,6 +128,7 @@ bad --modality "$NERAF" train --data "$FIX" --out "$WORK/run" --modality sound
 bad --preset "$NERAF" train --data "$FIX" --out "$WORK/run" --preset huge
 bad --cache-precision "$NERAF" train --data "$FIX" --out "$WORK/run" --cache-precision fp8
 bad --cache-precision "$NERAF" eval --run "$FIX" --json "$WORK/e.json" --cache-precision half
+bad --cache-precision "$NERAF" calibrate --run "$FIX" --cache-precision fp8
 bad --layout "$NERAF" synth --preset demo --out "$WORK/ds" --layout ambisonic
 bad --variant "$NERAF" metrics --rir "$WAV" --variant bogus
 bad --precision "$NERAF" export --run "$FIX" --out "$WORK/m.nrf" --precision fp64
@@ -182,6 +183,10 @@ expect_exit 0 timeout 300 "$NERAF" eval --run "$TMP/run32" --json "$TMP/eval32.j
 expect_file "$TMP/eval32.json"
 [ "$(ls "$TMP/cache32" | wc -l)" -eq 1 ] || fail "eval made another cache: $(ls "$TMP/cache32")"
 ls "$DATA/.neraf_cache"/*.bin >/dev/null 2>&1 && fail "eval ignored the run's --cache-dir"
+# calibrate too.
+expect_exit 0 timeout 300 "$NERAF" calibrate --run "$TMP/run32" --quiet
+[ "$(ls "$TMP/cache32" | wc -l)" -eq 1 ] || fail "calibrate made another cache: $(ls "$TMP/cache32")"
+ls "$DATA/.neraf_cache"/*.bin >/dev/null 2>&1 && fail "calibrate ignored the run's --cache-dir"
 # ... and --cache-dir on eval puts it elsewhere.
 expect_exit 0 timeout 300 "$NERAF" eval --run "$TMP/run32" --json "$TMP/eval_c.json" --skip-vision \
   --no-images --no-baselines --quiet --cache-dir "$TMP/cache_eval"

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# SIGKILL at random moments of a training run, then --resume, KILLS times; then the run finishes.
+# SIGKILL at random moments of a training run, then --resume, KILLS times; then the run finishes;
+# then a full disk during a checkpoint write and during synth.
 # Every step writes a checkpoint (--save-every 1), so many kills land inside a checkpoint write.
 # Checks: every restart succeeds and never meets a damaged checkpoint, the orphaned temporary
 # files of a kill are gone after the next start, and the finished run renders exactly the RIR of
@@ -67,6 +68,27 @@ for run in reference run; do
 done
 cmp -s "$TMP/reference.wav" "$TMP/run.wav" ||
   fail "the killed and resumed run renders another RIR than the uninterrupted one"
+# A full disk during a checkpoint write (simulated with a file size limit: writes past it fail
+# with EFBIG, as on a full disk with ENOSPC): one error line, exit 1, no temporary file, and the
+# checkpoints before it intact.
+(trap '' XFSZ; ulimit -f 20000; exec "$NERAF" train --out "$R" --resume --steps 41 --quiet) \
+  >"$TMP/out" 2>"$TMP/err"
+rc=$?
+[ "$rc" -eq 1 ] || fail "a full disk during a checkpoint write exited $rc: $(tail -c 300 "$TMP/err")"
+expect_in "$TMP/err" "step-000000041.pt: write failed"
+[ "$(grep -c . "$TMP/err")" -eq 1 ] || fail "expected one error line: $(cat "$TMP/err")"
+[ "$(temporaries)" -eq 0 ] || fail "the failed write left $(find "$R" -name '*.tmp-*')"
+[ -e "$R/checkpoints/step-000000041.pt" ] && fail "a checkpoint was written past the disk limit"
+expect_exit 0 "$NERAF" train --out "$R" --resume --steps 41 --quiet
+grep -q "damaged" "$TMP/err" && fail "the resume after a full disk met a damaged checkpoint"
+# The same for a dataset: a synth that runs out of space leaves nothing behind.
+(trap '' XFSZ; ulimit -f 50; exec "$NERAF" synth --preset demo --layout soundspaces \
+  --out "$TMP/full" --seed 3 --quiet) >"$TMP/out" 2>"$TMP/err"
+rc=$?
+[ "$rc" -eq 1 ] || fail "synth on a full disk exited $rc: $(tail -c 300 "$TMP/err")"
+[ -e "$TMP/full" ] && fail "synth on a full disk left $TMP/full"
+[ "$(find "$TMP" -maxdepth 1 -name '.full.tmp-*' | wc -l)" -eq 0 ] || fail "synth left a temporary folder"
+
 echo "kill_resume: $restarts kills ($in_write during a checkpoint write, $orphans orphaned temporary" \
   "files, all removed by the next start); newest checkpoint after each kill: ${steps[*]:-none}"
 finish kill_resume

@@ -302,3 +302,62 @@ TEST_F(AudioFileTest, FlacRejectsTooManyChannels) {
   neraf::io::write_audio(path("many.wav"), random_audio(9, 10, 48000, 8));
   EXPECT_EQ(neraf::io::read_audio(path("many.wav")).num_channels(), 9);
 }
+
+namespace {
+
+// A float WAV holding exactly `samples` (mono), written through libsndfile directly: write_audio
+// refuses non-finite samples.
+void write_raw_float_wav(const std::string& p, const std::vector<float>& samples) {
+  SF_INFO info{};
+  info.samplerate = 48000;
+  info.channels = 1;
+  info.format = SF_FORMAT_WAV | SF_FORMAT_FLOAT;
+  SNDFILE* f = sf_open(p.c_str(), SFM_WRITE, &info);
+  ASSERT_NE(f, nullptr);
+  sf_command(f, SFC_SET_ADD_PEAK_CHUNK, nullptr, SF_FALSE);
+  ASSERT_EQ(sf_writef_float(f, samples.data(), sf_count_t(samples.size())),
+            sf_count_t(samples.size()));
+  sf_close(f);
+}
+
+}  // namespace
+
+TEST_F(AudioFileTest, NonFiniteAndHugeSamplesAreRejected) {
+  for (const float bad : {std::nanf(""), INFINITY, -1e30f, 1001.0f}) {
+    std::vector<float> x(500, 0.1f);
+    x[321] = bad;
+    const std::string p = path("bad.wav");
+    write_raw_float_wav(p, x);
+    expect_error([&] { neraf::io::read_audio(p); }, {p, "sample 321 of channel 0", "re-export"});
+  }
+  // Loud but plausible (float files may exceed full scale): read as stored.
+  std::vector<float> loud(500, 0.1f);
+  loud[7] = 999.0f;
+  write_raw_float_wav(path("loud.wav"), loud);
+  EXPECT_EQ(neraf::io::read_audio(path("loud.wav")).channels[0][7], 999.0f);
+}
+
+// The example: a header promising 48,000 samples with 5 present (a copy cut short).
+TEST_F(AudioFileTest, HeaderPromisingMoreSamplesThanPresentIsTruncated) {
+  const std::string good = path("good.wav");
+  neraf::io::write_audio(good, random_audio(1, 48000, 48000, 3));
+  std::ifstream in(good, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  const size_t data = bytes.find("data");
+  ASSERT_NE(data, std::string::npos);
+  const std::string p = path("cut.wav");
+  std::ofstream(p, std::ios::binary) << bytes.substr(0, data + 8 + 5 * 4);
+  expect_error([&] { neraf::io::read_audio(p); }, {p, "truncated"});
+  expect_error([&] { neraf::io::read_audio_info(p); }, {p, "truncated"});
+}
+
+TEST_F(AudioFileTest, InfoReadsTheHeaderOnly) {
+  const std::string p = path("a.flac");
+  neraf::io::write_audio(p, random_audio(2, 1234, 22050, 6));
+  const neraf::io::AudioFileInfo i = neraf::io::read_audio_info(p);
+  EXPECT_EQ(i.sample_rate, 22050);
+  EXPECT_EQ(i.channels, 2);
+  EXPECT_EQ(i.frames, 1234);
+  expect_error([&] { neraf::io::read_audio_info(path("none.wav")); }, {"none.wav", "no such"});
+  expect_error([&] { neraf::io::read_audio_info(dir_.string()); }, {"folder"});
+}

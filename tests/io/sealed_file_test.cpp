@@ -45,6 +45,9 @@ TEST(SealedFile, DamageOfEveryKindIsNamed) {
   EXPECT_NE(error_of(file, 1).find("format version 2 is newer"), std::string::npos);
   EXPECT_NE(error_of("PK\x03\x04...").find("wrong magic"), std::string::npos);
   EXPECT_NE(error_of("").find("wrong magic"), std::string::npos);
+  std::string reserved = file;
+  reserved[12] = 0x40;  // found by fuzz/fuzz_sealed_file
+  EXPECT_NE(error_of(reserved, 2).find("x.pt: damaged (the reserved"), std::string::npos);
   EXPECT_EQ(error_of(file, 2), "");
 }
 

@@ -9,6 +9,7 @@
 #include "neraf/data/rir_set.h"
 #include "neraf/infer/calibration.h"
 #include "neraf/infer/run.h"
+#include "neraf/infer/train_config.h"
 #include "neraf/io/folder_lock.h"
 #include "neraf/io/json_file.h"
 #include "neraf/util/error.h"
@@ -21,6 +22,8 @@ struct CalibrateArgs {
   std::string data;
   std::string checkpoint;
   bool quiet = false;
+  std::string cache_dir, cache_precision;  // "": the run's (RUN/config.json audio.cache_*)
+  CLI::Option* cache_dir_opt = nullptr;
 };
 
 void run_calibrate(const CalibrateArgs& args) {
@@ -31,6 +34,13 @@ void run_calibrate(const CalibrateArgs& args) {
           manifest_path + ": no audio dataset in this run (trained with --modality vision)");
   data::RirLoadOptions load;
   load.progress = !args.quiet;
+  // The cache training used (recorded in its config), unless the flags say otherwise.
+  const std::string config_path = args.run_dir + "/config.json";
+  const infer::TrainConfig cfg =
+      infer::train_config_from_json(io::read_json(config_path), config_path);
+  load.cache_dir = args.cache_dir_opt->count() ? args.cache_dir : cfg.audio.cache_dir;
+  load.half_precision = data::parse_cache_precision(
+      args.cache_precision.empty() ? cfg.audio.cache_precision : args.cache_precision);
   const std::string data_dir = args.data.empty() ? manifest["data"].get<std::string>() : args.data;
   const data::RirSet rirs = data::load_rir_set(data_dir, load);
   const std::string path = infer::calibrate_run(args.run_dir, rirs, args.checkpoint);
@@ -55,6 +65,13 @@ void register_calibrate(CLI::App& app) {
                   "a checkpoint file of the run (default: the latest)")
       ->check(CLI::ExistingFile);
   cmd->add_flag("--quiet", args->quiet, "No progress bar");
+  args->cache_dir_opt = cmd->add_option(
+      "--cache-dir", args->cache_dir,
+      "folder of the RIR feature cache (default: the one the run was trained with, recorded in "
+      "RUN/config.json)");
+  cmd->add_option("--cache-precision", args->cache_precision,
+                  "feature cache values, fp32 or fp16 (default: the run's)")
+      ->check(CLI::IsMember({"fp32", "fp16"}));
   cmd->footer(
       "Writes RUN/checkpoints/step-XXXXXXXXX.calibration.pt beside the checkpoint.\n"
       "Example: neraf calibrate --run runs/demo");

@@ -1,6 +1,8 @@
 // `neraf info DIR`: what a dataset folder holds (layout, counts, sample rate, durations, pose
 // boxes, T60 distribution) and every problem the loaders would stumble on, each with its file,
-// what is wrong and how to fix it. Exit 1 when there is any error (warnings alone exit 0).
+// what is wrong and how to fix it. The checks are the loaders' own (data/validate.h), so no
+// error here means `neraf train` accepts the data. Exit 1 when there is any error (warnings
+// alone exit 0).
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
@@ -123,9 +125,11 @@ void register_info(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "info",
       "Inspect and validate a dataset folder: detects the layout (SoundSpaces, RAF, nerfstudio "
-      "images, simulated scene), checks every file the loaders read (split entries, audio "
-      "headers: sample rate, channels; poses; images vs intrinsics) and prints a summary "
-      "(counts, durations, mic/source boxes, audio aabb, T60). Exits 1 if any error is found.");
+      "images, simulated scene), checks every file training reads with the loaders' own checks "
+      "(split entries; poses; every RIR and magnitude file in full: truncation, sample rate, "
+      "channels, NaN or huge samples, length; every image: truncation, decoding, size vs "
+      "intrinsics, duplicates) and prints a summary (counts, durations, mic/source boxes, audio "
+      "aabb, T60). Exits 1 if any error is found: no error means training accepts the data.");
   cmd->add_option("dir", args->dir,
                   "Dataset folder (a SoundSpaces scene, a RAF room, or a "
                   "nerfstudio folder with transforms.json)")
@@ -137,10 +141,10 @@ void register_info(CLI::App& app) {
       ->transform(whole_number(0, 10000000));
   cmd->add_option("--t60-sample", args->t60_sample,
                   "Measure T60 on at most this many RIRs (an evenly spaced subset on larger "
-                  "datasets; all other checks read every file's header)")
+                  "datasets; the checks read every file)")
       ->capture_default_str()
       ->transform(whole_number(1, 100000000));
-  cmd->add_flag("--no-t60", args->no_t60, "Skip the T60 summary (reads no audio samples)");
+  cmd->add_flag("--no-t60", args->no_t60, "Skip the T60 summary");
   cmd->add_flag("--json", args->json,
                 "Print the summary and the problem list as JSON on stdout instead of text");
   cmd->callback([args] { run(*args); });

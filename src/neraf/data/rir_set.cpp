@@ -311,7 +311,20 @@ RirSet load(const std::string& dir, AudioLayout layout, const RirLoadOptions& op
     set.max_len = options.max_len;
     set.waveform_length = set.max_len * set.stft.hop_length;
   }
-  if (options.load_features) attach_features(set, idx, options);
+  if (options.load_features) {
+    // A refused or interrupted build leaves no cache folder it created behind (fs::remove only
+    // removes an empty folder; one holding other caches stays).
+    std::error_code ec;
+    std::vector<std::string> created;
+    for (const std::string& d : {(fs::path(set.root) / ".neraf_cache").string(), options.cache_dir})
+      if (!d.empty() && !fs::exists(d, ec)) created.push_back(d);
+    try {
+      attach_features(set, idx, options);
+    } catch (...) {
+      for (const std::string& d : created) fs::remove(d, ec);
+      throw;
+    }
+  }
   return set;
 }
 

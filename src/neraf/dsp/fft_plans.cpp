@@ -62,8 +62,11 @@ class PlanCache {
 };
 
 PlanCache& plan_cache() {
-  static PlanCache cache;  // intentionally never destroyed before exit: plans are reused until then
-  return cache;
+  // Never destroyed, not even at exit: a thread still transforming while the process exits never
+  // meets a freed plan, and the plans stay reachable (no leak report from LeakSanitizer, which
+  // flagged them when a static cache's map was destroyed at exit without them).
+  static PlanCache* const cache = new PlanCache;
+  return *cache;
 }
 
 }  // namespace

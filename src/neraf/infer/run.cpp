@@ -117,8 +117,8 @@ void check_vision_run_data(const std::string& vision_run, const nlohmann::json& 
   const std::string their = was.value("data", std::string("?"));
   const std::string ours = now.value("data", std::string("?"));
   auto refuse = [&](const std::string& what) {
-    throw Error(vision_run + ": trained on " + their + ", not on --data " + ours + ": the " + what +
-                " do not match); pass the vision run trained on this dataset");
+    throw Error(vision_run + ": trained on " + their + ", not on --data " + ours + " (its " + what +
+                " differ); pass the vision run trained on this dataset");
   };
   for (const char* key : {"num_train", "width", "height", "train_files"})
     if (was.value(key, nlohmann::json()) != now.value(key, nlohmann::json())) refuse(key);
@@ -139,7 +139,7 @@ void check_vision_run_data(const std::string& vision_run, const nlohmann::json& 
     same = a[r].is_array() && b[r].is_array() && a[r].size() == b[r].size();
     for (size_t c = 0; same && c < a[r].size(); ++c) same = close(a[r][c], b[r][c]);
   }
-  if (!same) refuse("the camera poses (world_transform)");
+  if (!same) refuse("camera poses (world_transform)");
 }
 
 torch::Tensor manifest_eval_poses(const nlohmann::json& m) {

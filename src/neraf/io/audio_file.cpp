@@ -67,6 +67,9 @@ SndHandle open_checked(const std::string& path, SF_INFO& info, uintmax_t& bytes,
   std::error_code ec;
   require(fs::exists(path, ec), path + ": no such file; check the path");
   require(!fs::is_directory(path, ec), path + ": is a folder, expected an audio file");
+  // A FIFO or device would block the reader (or never end); datasets and inputs are files.
+  require(fs::is_regular_file(path, ec),
+          path + ": is not a regular file (a pipe or device?); pass an audio file");
   bytes = fs::file_size(path, ec);
   size_known = !ec;
   require(!size_known || bytes > 0,

@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 
@@ -76,6 +77,11 @@ int64_t NpyHeader::num_elements() const {
 }
 
 NpyHeader read_npy_header(const std::string& path) {
+  std::error_code ec;
+  require(!std::filesystem::is_directory(path, ec), path + ": is a folder, expected a .npy file");
+  // A FIFO or device would block the reader; the size check below needs a file.
+  require(!std::filesystem::exists(path, ec) || std::filesystem::is_regular_file(path, ec),
+          path + ": is not a regular file (a pipe or device?); pass a .npy file");
   std::ifstream in(path, std::ios::binary);
   require(in.good(), path + ": cannot open (" + std::strerror(errno) + "); check that it exists");
   char magic[8];

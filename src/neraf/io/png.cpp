@@ -106,6 +106,8 @@ std::string jpeg_problem(const std::vector<uint8_t>& b) {
 std::string image_file_problem(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) return "a folder, not an image file";
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    return "not a regular file (a pipe or device?)";
   std::ifstream in(path, std::ios::binary);
   if (!in.good()) return std::string("cannot be opened (") + std::strerror(errno) + ")";
   const std::vector<uint8_t> b((std::istreambuf_iterator<char>(in)), {});

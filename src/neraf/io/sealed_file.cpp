@@ -59,6 +59,9 @@ Unsealed unseal(std::string_view file, std::string_view magic, uint32_t max_vers
   require(out.version <= max_version,
           path + ": format version " + std::to_string(out.version) + " is newer than this neraf (" +
               std::to_string(max_version) + "); use the neraf that wrote it or a newer one");
+  // Found by fuzz/fuzz_sealed_file: a non-zero reserved field passed, so two different files
+  // unsealed to one payload.
+  require(get_le(file, 12, 4) == 0, path + ": damaged (the reserved header field is not zero)");
   const uint64_t size = get_le(file, 16, 8);
   const uint64_t have = file.size() - kSealHeaderBytes;
   require(size == have, path + ": truncated or extended (" + std::to_string(have) +

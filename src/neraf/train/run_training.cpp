@@ -66,7 +66,9 @@ void calibrate_if_needed(const TrainConfig& cfg, const std::string& run_dir,
 
 }  // namespace
 
-TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions& options) {
+namespace {
+
+TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOptions& options) {
   const fs::path run(options.run_dir);
   const std::string config_path = run_file(options.run_dir, "config.json");
   const std::string manifest_path = run_file(options.run_dir, "data.json");
@@ -110,7 +112,9 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
   std::string data_dir = options.data_dir;
   if (data_dir.empty() && old_manifest.contains("data")) data_dir = old_manifest["data"];
   require(!data_dir.empty(), "--data: required (the dataset folder or its transforms.json)");
-  const data::ImageSet images = data::load_transforms_json(data_dir);
+  data::ImageLoadOptions image_load;
+  image_load.progress = options.progress;
+  const data::ImageSet images = data::load_transforms_json(data_dir, image_load);
   nlohmann::json manifest = infer::make_data_manifest(images, data_dir);
   if (cfg.modality == Modality::audio)
     infer::check_vision_run_data(cfg.audio.vision_run, manifest);  // not another room's field
@@ -239,6 +243,21 @@ TrainRunSummary run_training(const TrainConfig& config_in, const TrainRunOptions
   }
   calibrate_if_needed(cfg, options.run_dir, summary.checkpoint, summary.end_step, rirs.get());
   return summary;
+}
+
+}  // namespace
+
+TrainRunSummary run_training(const TrainConfig& config, const TrainRunOptions& options) {
+  std::error_code ec;
+  const bool created = !fs::exists(options.run_dir, ec);
+  try {
+    return train_run_folder(config, options);
+  } catch (...) {
+    // A refused or failed run leaves no folder behind that it created and wrote no checkpoint to.
+    if (created && infer::checkpoints_newest_first(options.run_dir).empty())
+      fs::remove_all(options.run_dir, ec);
+    throw;
+  }
 }
 
 }  // namespace neraf::train

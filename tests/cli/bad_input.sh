@@ -1,0 +1,331 @@
+#!/usr/bin/env bash
+# Bad input FILES on every command (bad_flags.sh does the flag values): truncated, foreign,
+# empty, NaN/Inf/huge audio (WAV, FLAC), PNGs cut short, .npy magnitudes, transforms.json,
+# points.txt, RAF poses, split files, scene / path / pose-list JSON, run folders with a missing or
+# damaged config.json / data.json / checkpoint, model files, folders and pipes where files are
+# expected. Each must exit 1 or 2 within 60 s, print one "error:" line naming the file (for
+# `info`: exactly one problem naming it, plus its closing summary line), and leave nothing behind
+# (no output, no feature cache, no temporary file). Dataset damage is tried on both `info` and
+# `train`: what info accepts, training accepts.
+# Usage: bad_input.sh <path to neraf> <assets dir>
+set -u
+NERAF=$1
+ASSETS=$2
+source "$(dirname "$0")/lib.sh"
+
+WAV="$ASSETS/real/rir_clap.wav"
+DRY="$ASSETS/real/castanets_dry.wav"
+BASE="$TMP/base"
+mkdir -p "$BASE"
+classes=0
+case_no=0
+
+# --- base data: tiny datasets (SoundSpaces + images, RAF, another room), a tiny run, a model ---
+quiet() { "$@" >"$TMP/setup.log" 2>&1 || { cat "$TMP/setup.log"; echo "setup failed: $*"; exit 1; }; }
+quiet "$NERAF" synth --preset demo --layout soundspaces --mics random --mic-count 2 --seed 3 \
+  --out "$BASE/ss" --quiet
+quiet "$NERAF" synth --preset demo --layout raf --mics random --mic-count 2 --seed 3 \
+  --out "$BASE/raf" --quiet
+quiet "$NERAF" synth --preset shoebox --layout soundspaces --mics random --mic-count 2 --seed 5 \
+  --out "$BASE/other_room" --quiet
+quiet "$NERAF" train --data "$BASE/ss" --out "$BASE/run" --steps 2 --audio-start-step 1 \
+  --rays 128 --quiet
+quiet "$NERAF" export --run "$BASE/run" --out "$BASE/model.nrf"
+# The dataset copies below must not inherit the run's feature cache.
+rm -rf "$BASE/ss/.neraf_cache"
+
+# python3 helpers: damaged files written byte by byte (no numpy needed).
+py() { python3 - "$@"; }
+# float_wav PATH RATE CHANNELS VALUE_AT_100 [DECLARED_FRAMES]: 2000 frames of 0.01, one odd value
+float_wav() {
+  py "$@" <<'PY'
+import struct, sys
+path, rate, ch, odd = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4])
+declared = int(sys.argv[5]) if len(sys.argv) > 5 else None
+n = 2000 if declared is None else 5
+x = [0.01] * (n * ch)
+if n > 100: x[100 * ch] = odd
+frames = declared if declared is not None else n
+data = struct.pack("<%df" % len(x), *x)
+hdr = b"RIFF" + struct.pack("<I", 36 + frames * ch * 4) + b"WAVEfmt " + struct.pack(
+    "<IHHIIHH", 16, 3, ch, rate, rate * ch * 4, ch * 4, 32) + b"data" + struct.pack("<I", frames * ch * 4)
+open(path, "wb").write(hdr + data)
+PY
+}
+# npy PATH T VALUE_AT_300: a [2, 257, T] float32 magnitude file (0.5 everywhere, one odd value)
+npy() {
+  py "$@" <<'PY'
+import struct, sys
+path, t, odd = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
+d = "{'descr': '<f4', 'fortran_order': False, 'shape': (2, 257, %d), }" % t
+d += " " * ((64 - (10 + len(d) + 1) % 64) % 64) + "\n"
+v = [0.5] * (2 * 257 * t)
+v[300] = odd
+open(path, "wb").write(b"\x93NUMPY\x01\x00" + struct.pack("<H", len(d)) + d.encode() +
+                       struct.pack("<%df" % len(v), *v))
+PY
+}
+# cut FILE: keep the first half of its bytes
+cut_half() { local n; n=$(stat -c %s "$1"); head -c $((n / 2)) "$1" >"$1.half" && mv "$1.half" "$1"; }
+# json_set FILE PYTHON_EXPR: rewrite a JSON file through `d` (python)
+json_edit() {
+  py "$1" "$2" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+exec(sys.argv[2])
+open(sys.argv[1], "w").write(json.dumps(d))
+PY
+}
+
+# fresh NAME SRC: a copy of base dataset/run SRC as $D (damage it, then call bad)
+fresh() { D="$TMP/c_$1"; rm -rf "$D"; cp -r "$BASE/$2" "$D"; }
+# out: a fresh output path under $O that must not exist after a refused command
+next_out() { case_no=$((case_no + 1)); O="$TMP/o_$case_no"; }
+
+# check WHAT NAME MODE: the last command (output in $TMP/out, $TMP/err, exit code $got) failed
+# cleanly. MODE info: the problem lines ("error: ...") are one naming NAME plus the summary.
+check() {
+  local what=$1 name=$2 mode=$3
+  if [ "$got" -eq 124 ]; then
+    fail "$what: still running after 60 s"
+  elif [ "$got" -ne 1 ] && [ "$got" -ne 2 ]; then
+    fail "$what: exited $got, expected 1 or 2; stderr: $(tail -c 300 "$TMP/err")"
+  fi
+  local n
+  n=$(grep -c '^error:' "$TMP/err")
+  if [ "$mode" = info ]; then
+    # One problem per line (a damaged points.txt also orphans the split entries using it), the
+    # first naming the file, then the summary line.
+    [ "$n" -ge 2 ] ||
+      fail "$what: $n error lines, expected problems + summary: $(head -c 600 "$TMP/err")"
+    tail -n 1 "$TMP/err" | grep -q "error(s) found" || fail "$what: no summary line"
+  else
+    [ "$n" -eq 1 ] || fail "$what: $n error lines, expected 1: $(head -c 600 "$TMP/err")"
+  fi
+  grep '^error:' "$TMP/err" | head -n 1 | grep -qF -- "$name" ||
+    fail "$what: the error does not name '$name': $(grep '^error:' "$TMP/err" | head -c 400)"
+  if grep -q "bad_alloc\|terminate called\|Exception raised from" "$TMP/err"; then
+    fail "$what: raw library text: $(head -c 300 "$TMP/err")"
+  fi
+  [ -e "$O" ] && fail "$what: left $O behind"
+  if [ -n "${D:-}" ] && [ -e "$D" ]; then
+    local left
+    left=$(find "$D" -name '.neraf_cache' -o -name '*.tmp-*' | head -n 3)
+    [ -z "$left" ] || fail "$what: left $left behind"
+  fi
+}
+run() { timeout 60 "$@" >"$TMP/out" 2>"$TMP/err"; got=$?; }
+
+# bad NAME CMD...: one class of bad input to a command other than info
+bad() {
+  local name=$1; shift
+  classes=$((classes + 1))
+  next_out
+  local cmd=("${@//@OUT@/$O}")
+  run "${cmd[@]}"
+  check "${cmd[*]#"$NERAF" }" "$name" cmd
+}
+# bad_data NAME: the damaged dataset $D is refused by info (one problem naming NAME) and by train
+bad_data() {
+  local name=$1
+  classes=$((classes + 1))
+  next_out
+  run "$NERAF" info --no-t60 "$D"
+  check "info ${D#"$TMP/"} ($name)" "$name" info
+  run "$NERAF" train --data "$D" --out "$O" --steps 2 --audio-start-step 1 --rays 64 --quiet
+  check "train on ${D#"$TMP/"} ($name)" "$name" cmd
+}
+
+SSW=binaural_rirs/0   # a folder of SoundSpaces RIRs of the base set
+first_ss_wav() { ls "$D/$SSW"/*.wav | head -n 1; }
+RAFW=data/000001/rir.wav
+
+# --- audio files of a dataset ---------------------------------------------------------------
+fresh trunc raf; float_wav "$D/$RAFW" 48000 1 0 48000  # the header promises 48000, 5 present
+bad_data "$RAFW"
+fresh half_wav ss; W=$(first_ss_wav); cut_half "$W"
+bad_data "${W#"$D/"}"
+fresh empty_wav raf; : >"$D/$RAFW"
+bad_data "$RAFW"
+fresh foreign_wav raf; echo "meeting notes, not a recording" >"$D/$RAFW"
+bad_data "$RAFW"
+fresh png_as_wav ss; W=$(first_ss_wav); cp "$(ls "$D"/images/*.png | head -n 1)" "$W"
+bad_data "${W#"$D/"}"
+fresh nan_wav raf; float_wav "$D/$RAFW" 48000 1 nan
+bad_data "$RAFW"
+fresh inf_wav ss; W=$(first_ss_wav); float_wav "$W" 44100 2 inf
+bad_data "${W#"$D/"}"
+fresh huge_wav raf; float_wav "$D/$RAFW" 48000 1 1e30
+bad_data "$RAFW"
+fresh rate_wav raf; float_wav "$D/$RAFW" 44100 1 0.5
+bad_data "$RAFW"
+fresh dir_wav raf; rm "$D/$RAFW"; mkdir "$D/$RAFW"
+bad_data "$RAFW"
+fresh fifo_wav raf; rm "$D/$RAFW"; mkfifo "$D/$RAFW"
+bad_data "$RAFW"
+fresh long_wav ss; W=$(first_ss_wav)
+py "$W" <<'PY'
+import struct, sys  # 40 s binaural at 44.1 kHz: longer than any impulse response
+n = 40 * 44100 * 2
+hdr = b"RIFF" + struct.pack("<I", 36 + n * 4) + b"WAVEfmt " + struct.pack(
+    "<IHHIIHH", 16, 3, 2, 44100, 44100 * 8, 8, 32) + b"data" + struct.pack("<I", n * 4)
+open(sys.argv[1], "wb").write(hdr + struct.pack("<f", 0.01) * n)
+PY
+bad_data "${W#"$D/"}"
+grep -q "GB feature cache" "$TMP/err" || fail "long RIR: no cache estimate: $(cat "$TMP/err")"
+
+# --- SoundSpaces magnitude files (every RIR needs one for them to be used) ------------------
+with_npy() {  # with_npy NAME: $D = the SoundSpaces set with a clean .npy per RIR
+  fresh "$1" ss
+  local w rel
+  for w in "$D"/binaural_rirs/*/*.wav; do
+    rel=${w#"$D/binaural_rirs/"}
+    mkdir -p "$D/binaural_magnitudes_sr22050/$(dirname "$rel")"
+    npy "$D/binaural_magnitudes_sr22050/${rel%.wav}.npy" 5 0.5
+  done
+  NPY=$(ls "$D"/binaural_magnitudes_sr22050/0/*.npy | head -n 1)
+  NPY=${NPY#"$D/"}
+}
+with_npy npy_ok
+run "$NERAF" info --no-t60 "$D"
+[ "$got" -eq 0 ] || fail "info on clean .npy magnitudes exited $got: $(tail -c 300 "$TMP/err")"
+with_npy npy_nan; npy "$D/$NPY" 5 nan
+bad_data "$NPY"
+with_npy npy_negative; npy "$D/$NPY" 5 -1
+bad_data "$NPY"
+with_npy npy_half; cut_half "$D/$NPY"
+bad_data "$NPY"
+with_npy npy_foreign; echo "not numpy" >"$D/$NPY"
+bad_data "$NPY"
+with_npy npy_shape
+py "$D/$NPY" <<'PY'
+import struct, sys  # shape (3, 257, 5): one channel too many
+d = "{'descr': '<f4', 'fortran_order': False, 'shape': (3, 257, 5), }"
+d += " " * ((64 - (10 + len(d) + 1) % 64) % 64) + "\n"
+open(sys.argv[1], "wb").write(b"\x93NUMPY\x01\x00" + struct.pack("<H", len(d)) + d.encode() +
+                              struct.pack("<f", 0.5) * (3 * 257 * 5))
+PY
+bad_data "$NPY"
+
+# --- pose and split files -------------------------------------------------------------------
+fresh points_huge ss; sed -i '1s/^\([0-9]*\)\t[^\t]*/\1\t1e300/' "$D/metadata/points.txt"
+bad_data metadata/points.txt
+fresh points_text ss; sed -i '1s/.*/0\tone\ttwo\tthree/' "$D/metadata/points.txt"
+bad_data metadata/points.txt
+fresh points_missing ss; rm "$D/metadata/points.txt"; mkdir "$D/metadata/points.txt"
+bad_data metadata/points.txt
+fresh split_json ss; echo '{"train": [' >"$D/metadata_AudioNeRF/split.json"
+bad_data metadata_AudioNeRF/split.json
+fresh split_dup ss; json_edit "$D/metadata_AudioNeRF/split.json" 'd["train"].append(d["train"][0])'
+bad_data metadata_AudioNeRF/split.json
+fresh split_shape ss; echo '{"train": "0/1_2", "test": []}' >"$D/metadata_AudioNeRF/split.json"
+bad_data metadata_AudioNeRF/split.json
+fresh rx_huge raf; echo "1.0,1e300,2.0" >"$D/data/000001/rx_pos.txt"
+bad_data data/000001/rx_pos.txt
+fresh tx_nan raf; echo "0,0.7071,0,0.7071,nan,1.5,1.0" >"$D/data/000001/tx_pos.txt"
+bad_data data/000001/tx_pos.txt
+fresh tx_short raf; echo "0,0,0" >"$D/data/000001/tx_pos.txt"
+bad_data data/000001/tx_pos.txt
+fresh raf_split raf; echo '{"train": [], "test": [[1]]}' >"$D/metadata/data-split.json"
+bad_data metadata/data-split.json
+
+# --- images and transforms.json -------------------------------------------------------------
+IMG=$(cd "$BASE/ss" && ls images/*.png | head -n 1)
+fresh png_half ss; cut_half "$D/$IMG"
+bad_data "$IMG"
+fresh png_foreign ss; echo "not an image" >"$D/$IMG"
+bad_data "$IMG"
+fresh png_missing ss; rm "$D/$IMG"
+bad_data "$IMG"
+fresh tf_json ss; echo '{"frames": [' >"$D/transforms.json"
+bad_data transforms.json
+fresh tf_empty ss; : >"$D/transforms.json"
+bad_data transforms.json
+fresh tf_dup ss; json_edit "$D/transforms.json" 'd["frames"].append(dict(d["frames"][0]))'
+bad_data transforms.json
+fresh tf_far ss; json_edit "$D/transforms.json" 'd["frames"][0]["transform_matrix"][0][3] = 1e300'
+bad_data transforms.json
+fresh tf_nan ss; json_edit "$D/transforms.json" 'd["frames"][1]["transform_matrix"][1][2] = 4242.25'
+sed -i 's/4242.25/NaN/' "$D/transforms.json"  # as Python's json.dump writes a NaN
+bad_data transforms.json
+
+# Silence is legitimate (SoundSpaces ships silent RIRs): a warning info counts, training accepts.
+fresh zero_wav raf
+py "$D/$RAFW" <<'PY'
+import struct, sys  # 0.5 s of 0.0
+n = 24000
+hdr = b"RIFF" + struct.pack("<I", 36 + n * 4) + b"WAVEfmt " + struct.pack(
+    "<IHHIIHH", 16, 3, 1, 48000, 48000 * 4, 4, 32) + b"data" + struct.pack("<I", n * 4)
+open(sys.argv[1], "wb").write(hdr + bytes(n * 4))
+PY
+run "$NERAF" info --no-t60 "$D"
+[ "$got" -eq 0 ] || fail "info on a silent RIR exited $got"
+grep -q "^warning: .*$RAFW: every sample is zero" "$TMP/err" || fail "silent RIR: no warning"
+expect_in "$TMP/out" "0 error(s), 1 warning(s)"
+
+# --- runs: a vision run of another room, damaged run folders --------------------------------
+D=""
+bad "$BASE/run" "$NERAF" train --data "$BASE/other_room" --modality audio --vision-run "$BASE/run" \
+  --steps 2 --out @OUT@ --quiet
+fresh run_noconfig run; rm "$D/config.json"
+bad "$D" "$NERAF" eval --run "$D" --json @OUT@ --quiet
+fresh run_badconfig run; echo '{"preset": ' >"$D/config.json"
+bad "$D/config.json" "$NERAF" render view --run "$D" --frame 0 --out @OUT@
+fresh run_confdir run; rm "$D/config.json"; mkdir "$D/config.json"
+bad "$D" "$NERAF" export --run "$D" --out @OUT@
+fresh run_nodata run; rm "$D/data.json"
+bad "$D/data.json" "$NERAF" render view --run "$D" --frame 0 --out @OUT@
+fresh run_baddata run; echo '[1, 2' >"$D/data.json"
+bad "$D/data.json" "$NERAF" eval --run "$D" --json @OUT@ --quiet
+CK=$(ls "$BASE/run/checkpoints/"step-*.pt | grep -v calibration | tail -n 1)
+CK=${CK#"$BASE/run/"}
+fresh run_cut_ckpt run; for f in "$D"/checkpoints/step-*.pt; do cut_half "$f"; done
+bad "$D/checkpoints" "$NERAF" render view --run "$D" --frame 0 --out @OUT@
+D=""
+
+# --- model files ----------------------------------------------------------------------------
+cp "$BASE/model.nrf" "$TMP/half.nrf"; cut_half "$TMP/half.nrf"
+bad "$TMP/half.nrf" "$NERAF" render rir --model "$TMP/half.nrf" --mic 2,1.5,2.5 --src 1.1,1.2,0.9 \
+  --out @OUT@
+echo "not a model" >"$TMP/foreign.nrf"
+bad "$TMP/foreign.nrf" "$NERAF" eval --model "$TMP/foreign.nrf" --data "$BASE/ss" --json @OUT@ \
+  --quiet
+
+# --- audio given to metrics / auralize (WAV, FLAC) -------------------------------------------
+float_wav "$TMP/nan.wav" 48000 1 nan
+bad "$TMP/nan.wav" "$NERAF" metrics --rir "$TMP/nan.wav"
+quiet "$NERAF" auralize --rir "$WAV" --in "$DRY" --out "$TMP/good.flac"
+cp "$TMP/good.flac" "$TMP/half.flac"; cut_half "$TMP/half.flac"
+bad "$TMP/half.flac" "$NERAF" metrics --pred "$TMP/half.flac" --gt "$WAV"
+: >"$TMP/empty.wav"
+bad "$TMP/empty.wav" "$NERAF" auralize --rir "$WAV" --in "$TMP/empty.wav" --out @OUT@
+float_wav "$TMP/inf_dry.wav" 48000 1 -inf
+bad "$TMP/inf_dry.wav" "$NERAF" auralize --rir "$WAV" --in "$TMP/inf_dry.wav" --out @OUT@
+float_wav "$TMP/trunc_rir.wav" 48000 1 0 48000
+bad "$TMP/trunc_rir.wav" "$NERAF" auralize --rir "$TMP/trunc_rir.wav" --in "$DRY" --out @OUT@
+mkfifo "$TMP/pipe.wav"
+bad "$TMP/pipe.wav" "$NERAF" metrics --rir "$TMP/pipe.wav"
+
+# --- scene, path and pose-list JSON ---------------------------------------------------------
+echo '{"room": {"size": [5, 3,' >"$TMP/scene.json"
+bad "$TMP/scene.json" "$NERAF" synth --scene "$TMP/scene.json" --out @OUT@ --quiet
+"$NERAF" synth --preset demo --print-scene >"$TMP/scene_ok.json" 2>/dev/null
+json_edit "$TMP/scene_ok.json" 'd["room"] = "large"'
+bad "$TMP/scene_ok.json" "$NERAF" synth --scene "$TMP/scene_ok.json" --out @OUT@ --quiet
+echo '{"version": 1, "keyframes": [{"time": 0, "mic": [1, 1.5]' >"$TMP/path.json"
+bad "$TMP/path.json" "$NERAF" render trajectory --run "$BASE/run" --path "$TMP/path.json" \
+  --in "$DRY" --out @OUT@
+echo '{"version": 1, "poses": [{"mic": [2, 1.5, 2.5], "yaw": "north"}]}' >"$TMP/poses.json"
+bad "$TMP/poses.json" "$NERAF" render rir --run "$BASE/run" --poses "$TMP/poses.json" --out @OUT@
+: >"$TMP/empty_poses.json"
+bad "$TMP/empty_poses.json" "$NERAF" render rir --model "$BASE/model.nrf" \
+  --poses "$TMP/empty_poses.json" --out @OUT@
+
+# --- a file where a folder is expected, and the reverse -------------------------------------
+bad "$WAV" "$NERAF" train --data "$WAV" --out @OUT@ --steps 2 --audio-start-step 1 --quiet
+bad "$WAV" "$NERAF" eval --run "$WAV" --json @OUT@ --quiet
+bad "$ASSETS" "$NERAF" metrics --rir "$ASSETS"
+
+[ "$classes" -ge 30 ] || fail "only $classes classes of bad input"
+echo "$classes classes of bad input"
+finish bad_input
