@@ -326,6 +326,31 @@ bad "$WAV" "$NERAF" train --data "$WAV" --out @OUT@ --steps 2 --audio-start-step
 bad "$WAV" "$NERAF" eval --run "$WAV" --json @OUT@ --quiet
 bad "$ASSETS" "$NERAF" metrics --rir "$ASSETS"
 
+# --- an output that is one of the command's inputs or a file of the run it reads -------------
+cp "$DRY" "$TMP/own_dry.wav"
+cp "$BASE/model.nrf" "$TMP/own_model.nrf"
+bad "--in" "$NERAF" auralize --rir "$WAV" --in "$TMP/own_dry.wav" --out "$TMP/own_dry.wav"
+cmp -s "$DRY" "$TMP/own_dry.wav" || fail "auralize --out = --in changed the dry file"
+bad "--rir" "$NERAF" auralize --rir "$TMP/own_dry.wav" --in "$DRY" --out "$TMP/own_dry.wav"
+bad "config.json" "$NERAF" eval --run "$BASE/run" --json "$BASE/run/config.json" --skip-vision
+bad "checkpoints folder" "$NERAF" export --run "$BASE/run" \
+  --out "$(ls "$BASE"/run/checkpoints/step-*[0-9].pt | tail -1)"
+bad "--depth" "$NERAF" render view --run "$BASE/run" --frame 0 --out "$TMP/same.png" \
+  --depth "$TMP/same.png"
+bad "--model" "$NERAF" render loudness --model "$TMP/own_model.nrf" --src 1.1,1.2,0.9 \
+  --out "$TMP/own_model.nrf"
+cmp -s "$BASE/model.nrf" "$TMP/own_model.nrf" || fail "render loudness --out = --model changed the model"
+bad "--in" "$NERAF" render trajectory --model "$BASE/model.nrf" \
+  --path "$ASSETS/../examples/paths/demo_walk.json" --in "$TMP/own_dry.wav" --out "$TMP/own_dry.wav"
+bad "not .mp3" "$NERAF" auralize --rir "$WAV" --in "$DRY" --out @OUT@.mp3
+bad "--ablation-runs" "$NERAF" eval --run "$BASE/run" --json @OUT@ --skip-vision \
+  --ablation-runs "$BASE/run,$BASE/run"
+run "$NERAF" info "$BASE/ss" --json
+[ "$got" -eq 0 ] || fail "info --json on a good set exited $got"
+timeout 60 "$NERAF" info "$BASE/ss" --json >/dev/full 2>"$TMP/err"
+[ $? -eq 1 ] && grep -q "^error: cannot write to standard output" "$TMP/err" ||
+  fail "info --json > /dev/full did not fail: $(cat "$TMP/err")"
+
 [ "$classes" -ge 30 ] || fail "only $classes classes of bad input"
 echo "$classes classes of bad input"
 finish bad_input

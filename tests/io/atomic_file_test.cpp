@@ -106,6 +106,12 @@ TEST_F(AtomicFileTest, RefusesToReplaceAnythingButARegularFile) {
       EXPECT_NE(std::string(e.what()).find(kind), std::string::npos) << e.what();
     }
   }
+  try {
+    read_text_file(fifo.string());  // would block
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is not a regular file"), std::string::npos) << e.what();
+  }
   EXPECT_TRUE(fs::is_symlink(link));
   EXPECT_EQ(fs::status(fifo).type(), fs::file_type::fifo);
   EXPECT_EQ(read_text_file(real.string()), "keep");
@@ -134,7 +140,7 @@ TEST_F(AtomicFileTest, FolderIsBuiltBesideAndRenamedIntoPlace) {
                      write_text_atomically(tmp + "/b.txt", "half");
                      throw std::runtime_error("disk full");
                    },
-                   /*replace=*/true),
+                   FolderWrite::replace),
                std::runtime_error);
   EXPECT_EQ(read_text_file((out / "a.txt").string()), "a");
   EXPECT_TRUE(only_file_is(out));
@@ -142,10 +148,24 @@ TEST_F(AtomicFileTest, FolderIsBuiltBesideAndRenamedIntoPlace) {
   EXPECT_THROW(write_folder_atomically(out.string(), [](const std::string&) {}), Error);
   write_folder_atomically(
       out.string(), [](const std::string& tmp) { write_text_atomically(tmp + "/c.txt", "c"); },
-      /*replace=*/true);
+      FolderWrite::replace);
   EXPECT_FALSE(fs::exists(out / "a.txt"));
   EXPECT_EQ(read_text_file((out / "c.txt").string()), "c");
   EXPECT_TRUE(only_file_is(out));
+  // Merge: new files replace their namesakes, the others stay.
+  write_text_atomically((out / "keep.txt").string(), "k");
+  write_folder_atomically(
+      out.string(),
+      [](const std::string& tmp) {
+        write_text_atomically(tmp + "/c.txt", "c2");
+        write_text_atomically(tmp + "/d.txt", "d");
+      },
+      FolderWrite::merge);
+  EXPECT_EQ(read_text_file((out / "c.txt").string()), "c2");
+  EXPECT_EQ(read_text_file((out / "d.txt").string()), "d");
+  EXPECT_EQ(read_text_file((out / "keep.txt").string()), "k");
+  for (const auto& e : fs::directory_iterator(dir_))
+    EXPECT_EQ(e.path().filename().string().find(".tmp-"), std::string::npos) << e.path();
 }
 
 TEST_F(AtomicFileTest, StaleTemporariesOfDeadProcessesAreRemoved) {

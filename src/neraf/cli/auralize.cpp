@@ -9,6 +9,7 @@
 #include <string>
 
 #include "neraf/cli/commands.h"
+#include "neraf/cli/flag_checks.h"
 #include "neraf/cli/render_audio.h"
 #include "neraf/dsp/resample.h"
 #include "neraf/io/audio_file.h"
@@ -115,6 +116,11 @@ void register_auralize(CLI::App& app) {
     // still usage errors (exit 2).
     const bool field = run_opt->count() > 0 || model_opt->count() > 0;
     if (rir_opt->count() == 0 && !field) throw CLI::RequiredError("--rir, --run or --model");
+    require_safe_output({"--out", args->out_path},
+                        {{"--in", args->dry_path},
+                         {"--rir", args->rir_path},
+                         {"--model", args->field.model}},
+                        args->field.run);
     if (field) {
       if (pose_opts.first->count() == 0) throw CLI::RequiredError("--mic (with --run/--model)");
       if (pose_opts.second->count() == 0) throw CLI::RequiredError("--src (with --run/--model)");

@@ -10,6 +10,7 @@
 #include <memory>
 #include <numeric>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@
 #include "neraf/infer/audio_run.h"
 #include "neraf/infer/exported_model.h"
 #include "neraf/infer/run.h"
+#include "neraf/io/atomic_file.h"
 #include "neraf/io/json_file.h"
 #include "neraf/sim/synthesize.h"
 #include "neraf/util/error.h"
@@ -64,6 +66,13 @@ std::vector<std::string> split_commas(const std::string& s) {
   return out;
 }
 
+// The folder of the PNGs and per-RIR CSVs: written into a temporary folder (`written`) that is
+// merged into `shown` (RUN/eval, MODEL_eval or --images) once everything is scored, so a failed
+// evaluation leaves the files of the last one as they were (io::write_folder_atomically).
+struct OutputDir {
+  std::string written, shown;
+};
+
 // The RIRs one audio table scores: `test` of `test_set`, baselines from `train_subset` of
 // `train_set` (the run's own dataset).
 struct AudioEvalSet {
@@ -78,7 +87,8 @@ struct AudioEvalSet {
 nlohmann::json score_audio(const infer::AudioField& run,
                            const std::vector<std::pair<std::string, infer::AudioRun>>& ablations,
                            const AudioEvalSet& set, const eval::AudioEvalOptions& opts,
-                           const std::string& csv_name, const std::string& title) {
+                           const std::string& csv_name, const std::string& title,
+                           const OutputDir& dir) {
   eval::AudioEval e =
       eval::evaluate_audio(run, set.train_set, set.train_subset, set.test_set, set.test, opts);
   nlohmann::json out = eval::to_json(e);
@@ -99,9 +109,8 @@ nlohmann::json score_audio(const infer::AudioField& run,
     }
     out["ablations"] = abl;
   }
-  const std::string csv = (std::filesystem::path(opts.out_dir) / csv_name).string();
-  std::filesystem::create_directories(opts.out_dir);
-  eval::write_audio_csv(csv, e);
+  eval::write_audio_csv((std::filesystem::path(dir.written) / csv_name).string(), e);
+  const std::string csv = (std::filesystem::path(dir.shown) / csv_name).string();
   out["per_rir_csv"] = csv;
   std::printf("%s (%s, %zu RIRs, %.1f s; per-RIR CSV %s):\n%s%s", title.c_str(),
               data::to_string(set.test_set.layout), e.rir_ids.size(), e.seconds, csv.c_str(),
@@ -143,13 +152,13 @@ struct EvalField {
   uint64_t seed = 0;
   double audio_fraction = 1;
   std::string grid;
-  std::string default_out_dir;  // PNGs and CSVs without --images
-  CacheChoice cache;            // the run's feature cache (before the flags)
+  CacheChoice cache;  // the run's feature cache (before the flags)
 };
 
 // The acoustic field on the test RIRs (and, with --novel-data, on every RIR of another dataset of
 // the same room), with the nearest/linear baselines and the ablation runs.
-nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args) {
+nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args,
+                                   const OutputDir& dir) {
   const infer::AudioField& run = source.field;
   const std::string data_dir =
       args.data.empty() ? source.manifest.at("data").get<std::string>() : args.data;
@@ -159,7 +168,12 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
   const data::RirSet rirs = load_rirs(data_dir, !args.quiet, cache);
   infer::check_audio_manifest(source.manifest.at("audio"), rirs, data_dir);
   std::vector<std::pair<std::string, infer::AudioRun>> ablations;
+  std::set<std::string> labels;  // the table's and the JSON's name of each: its folder's name
   for (const std::string& dir : split_commas(args.ablation_runs)) {
+    const std::string label = std::filesystem::path(dir).lexically_normal().filename().string();
+    require(labels.insert(label).second,
+            "--ablation-runs: two runs are called '" + label +
+                "' (each is labelled by its folder's name); give each its own folder name");
     ablations.emplace_back(
         dir, infer::load_audio_run(dir, torch::kCPU, "", nerf::parse_precision(args.precision)));
     infer::check_audio_manifest(ablations.back().second.run().manifest.at("audio"), rirs,
@@ -169,7 +183,7 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
   opts.progress = !args.quiet;
   opts.baselines = !args.no_baselines;
   opts.seed = source.seed;
-  opts.out_dir = args.images.empty() ? source.default_out_dir : args.images;
+  opts.out_dir = dir.written;
   if (args.no_images) opts.num_images = 0;
   const std::vector<int64_t> subset =
       infer::audio_train_subset(rirs, source.audio_fraction, source.seed);
@@ -188,7 +202,7 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
     return rirs_to_score;
   };
   nlohmann::json out = score_audio(run, ablations, {rirs, subset, rirs, first_rirs(rirs.test)},
-                                   opts, "audio_per_rir.csv", "audio, held-out test split");
+                                   opts, "audio_per_rir.csv", "audio, held-out test split", dir);
   out["grid"] = source.grid;
   if (novel) {
     std::vector<int64_t> all(novel->rirs.size());
@@ -196,13 +210,14 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
     opts.num_images = 0;
     out["novel"] = score_audio(run, ablations, {rirs, subset, *novel, first_rirs(all)}, opts,
                                "audio_novel_per_rir.csv",
-                               "audio at new microphone positions (" + args.novel_data + ")");
+                               "audio at new microphone positions (" + args.novel_data + ")", dir);
     out["novel"]["data"] = args.novel_data;
   }
   return out;
 }
 
-nlohmann::json evaluate_vision_json(infer::LoadedRun& run, const EvalArgs& args) {
+nlohmann::json evaluate_vision_json(infer::LoadedRun& run, const EvalArgs& args,
+                                    const OutputDir& dir) {
   const std::string data_dir =
       args.data.empty() ? run.manifest.at("data").get<std::string>() : args.data;
   data::ImageLoadOptions load;
@@ -218,13 +233,11 @@ nlohmann::json evaluate_vision_json(infer::LoadedRun& run, const EvalArgs& args)
   opts.chunk = run.config.eval_rays_per_chunk;
   opts.max_views = args.max_views;
   opts.progress = !args.quiet;
-  if (!args.no_images)
-    opts.image_dir =
-        args.images.empty() ? (std::filesystem::path(args.run) / "eval").string() : args.images;
+  if (!args.no_images) opts.image_dir = dir.written;
   const eval::VisionEval e = eval::evaluate_vision(run.model, images.eval, opts);
   std::printf("vision: PSNR %.3f dB  SSIM %.4f  over %lld eval views (%.1f s)%s%s\n", e.psnr,
               e.ssim, static_cast<long long>(e.n_views), e.seconds,
-              opts.image_dir.empty() ? "" : "; GT|prediction images in ", opts.image_dir.c_str());
+              opts.image_dir.empty() ? "" : "; GT|prediction images in ", dir.shown.c_str());
   return eval::to_json(e);
 }
 
@@ -303,6 +316,7 @@ void register_eval(CLI::App& app) {
   cmd->callback([args]() {
     if (args->threads > 0) torch::set_num_threads(args->threads);
     if (args->run.empty() && args->model.empty()) throw CLI::RequiredError("--run or --model");
+    require_safe_output({"--json", args->json}, {{"--model", args->model}}, args->run);
     if (!args->model.empty()) {
       const infer::ExportedModel model = infer::load_exported_model(args->model);
       const nlohmann::json& meta = model.metadata();
@@ -313,13 +327,21 @@ void register_eval(CLI::App& app) {
                        meta.value("seed", uint64_t{0}),
                        meta.value("audio_fraction", 1.0),
                        meta.value("grid", std::string("sampled")),
-                       std::filesystem::path(args->model).replace_extension("").string() + "_eval",
                        {}};
       nlohmann::json out = {{"model", args->model},
                             {"run", meta.value("run", std::string())},
                             {"checkpoint", meta.value("checkpoint", std::string())},
                             {"step", meta.value("step", int64_t{0})}};
-      out["audio"] = evaluate_audio_json(source, *args);
+      const std::string shown =
+          args->images.empty()
+              ? std::filesystem::path(args->model).replace_extension("").string() + "_eval"
+              : args->images;
+      io::write_folder_atomically(
+          shown,
+          [&](const std::string& tmp) {
+            out["audio"] = evaluate_audio_json(source, *args, {tmp, shown});
+          },
+          io::FolderWrite::merge);
       io::write_json_atomically(args->json, out);
       return;
     }
@@ -330,34 +352,41 @@ void register_eval(CLI::App& app) {
     const infer::TrainConfig cfg =
         infer::train_config_from_json(io::read_json(config_path), config_path);
     nlohmann::json out = {{"run", args->run}};
-    if (cfg.modality != infer::Modality::vision) {
-      const infer::AudioRun audio = infer::load_audio_run(args->run, torch::kCPU, args->checkpoint,
-                                                          nerf::parse_precision(args->precision));
-      out["checkpoint"] = audio.run().checkpoint;
-      out["step"] = audio.step();
-      out["precision"] = args->precision;
-      const EvalField source{
-          audio,
-          audio.run().manifest,
-          audio.run().config.seed,
-          audio.run().config.audio.fraction,
-          audio.run().config.audio.grid,
-          (std::filesystem::path(args->run) / "eval").string(),
-          {audio.run().config.audio.cache_dir, audio.run().config.audio.cache_precision}};
-      out["audio"] = evaluate_audio_json(source, *args);
-    }
-    if (!args->skip_vision) {
-      // An audio-only run has no radiance field of its own: its --vision-run's is evaluated.
-      const bool own = cfg.modality != infer::Modality::audio;
-      infer::LoadedRun run = infer::load_run(own ? args->run : cfg.audio.vision_run, torch::kCPU,
-                                             own ? args->checkpoint : "");
-      if (!out.contains("checkpoint")) {
-        out["checkpoint"] = run.checkpoint;
-        out["step"] = run.step;
-      }
-      out["vision"] = evaluate_vision_json(run, *args);
-      if (!own) out["vision"]["run"] = cfg.audio.vision_run;
-    }
+    const std::string shown =
+        args->images.empty() ? (std::filesystem::path(args->run) / "eval").string() : args->images;
+    io::write_folder_atomically(
+        shown,
+        [&](const std::string& tmp) {
+          const OutputDir dir{tmp, shown};
+          if (cfg.modality != infer::Modality::vision) {
+            const infer::AudioRun audio = infer::load_audio_run(
+                args->run, torch::kCPU, args->checkpoint, nerf::parse_precision(args->precision));
+            out["checkpoint"] = audio.run().checkpoint;
+            out["step"] = audio.step();
+            out["precision"] = args->precision;
+            const EvalField source{
+                audio,
+                audio.run().manifest,
+                audio.run().config.seed,
+                audio.run().config.audio.fraction,
+                audio.run().config.audio.grid,
+                {audio.run().config.audio.cache_dir, audio.run().config.audio.cache_precision}};
+            out["audio"] = evaluate_audio_json(source, *args, dir);
+          }
+          if (!args->skip_vision) {
+            // An audio-only run has no radiance field of its own: its --vision-run's is evaluated.
+            const bool own = cfg.modality != infer::Modality::audio;
+            infer::LoadedRun run = infer::load_run(own ? args->run : cfg.audio.vision_run,
+                                                   torch::kCPU, own ? args->checkpoint : "");
+            if (!out.contains("checkpoint")) {
+              out["checkpoint"] = run.checkpoint;
+              out["step"] = run.step;
+            }
+            out["vision"] = evaluate_vision_json(run, *args, dir);
+            if (!own) out["vision"]["run"] = cfg.audio.vision_run;
+          }
+        },
+        io::FolderWrite::merge);
     io::write_json_atomically(args->json, out);
   });
 }

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "neraf/cli/commands.h"
+#include "neraf/cli/flag_checks.h"
 #include "neraf/infer/audio_run.h"
 #include "neraf/infer/exported_model.h"
 #include "neraf/util/error.h"
@@ -56,7 +57,10 @@ void register_export(CLI::App& app) {
   cmd->footer(
       "Example:\n  neraf export --run runs/demo --out demo.nrf\n  neraf render rir --model "
       "demo.nrf --mic 2,1.5,1.75 --src 1.1,1.2,0.9 --yaw 90 --out rir.wav");
-  cmd->callback([args] { run_export(*args); });
+  cmd->callback([args] {
+    require_safe_output({"--out", args->out_path}, {}, args->run_dir);
+    run_export(*args);
+  });
 }
 
 }  // namespace neraf::cli

@@ -1,8 +1,13 @@
 #include "neraf/cli/flag_checks.h"
 
+#include <filesystem>
 #include <string>
 
+#include "neraf/io/atomic_file.h"
+#include "neraf/util/error.h"
 #include "neraf/util/number_text.h"
+
+namespace fs = std::filesystem;
 
 namespace neraf::cli {
 
@@ -47,6 +52,35 @@ CLI::Validator thread_count() {
         return why;
       },
       range_text(int64_t{1}, int64_t{most}));
+}
+
+namespace {
+bool same_file(const std::string& a, const std::string& b) {
+  std::error_code ec;
+  if (fs::exists(a, ec) && fs::exists(b, ec)) return fs::equivalent(a, b, ec);
+  return fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec);
+}
+}  // namespace
+
+void require_safe_output(const FlagPath& out, const std::vector<FlagPath>& inputs,
+                         const std::string& run_dir) {
+  if (out.path.empty()) return;
+  io::require_replaceable_file(out.path);
+  for (const FlagPath& in : inputs)
+    require(in.path.empty() || !same_file(out.path, in.path),
+            out.flag + " " + out.path + ": is also " + in.flag +
+                "; writing it would destroy that file, so choose another output path");
+  if (run_dir.empty()) return;
+  const fs::path run(run_dir);
+  for (const char* name : {"config.json", "data.json", ".lock"})
+    require(!same_file(out.path, (run / name).string()),
+            out.flag + " " + out.path + ": is the run's own " + name +
+                "; choose an output path outside the run's files");
+  std::error_code ec;
+  const fs::path parent = fs::absolute(out.path, ec).parent_path();
+  require(!same_file(parent.string(), (run / "checkpoints").string()),
+          out.flag + " " + out.path +
+              ": is in the run's checkpoints folder; choose an output path outside it");
 }
 
 }  // namespace neraf::cli

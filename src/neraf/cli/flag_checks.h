@@ -7,6 +7,8 @@
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <limits>
+#include <string>
+#include <vector>
 
 namespace neraf::cli {
 
@@ -19,6 +21,18 @@ CLI::Validator seed_number(uint64_t hi = std::numeric_limits<uint64_t>::max());
 CLI::Validator real_number(double lo, double hi, bool lo_open = false);
 // --threads: [1, max_thread_count()] (4 x the machine's hardware threads).
 CLI::Validator thread_count();
+
+// A path a command was given, with the flag that gave it.
+struct FlagPath {
+  std::string flag, path;
+};
+
+// Before any work: neraf::Error unless the output `out` is a path that may be written (absent or
+// a regular file, io::require_replaceable_file), names none of `inputs` (nor another output), and
+// is no file of the run folder `run_dir` ("" for none): its config.json, data.json, lock or a
+// checkpoint. Outputs replacing their own inputs destroyed a user's recording, model or run.
+void require_safe_output(const FlagPath& out, const std::vector<FlagPath>& inputs,
+                         const std::string& run_dir = "");
 
 // Most steps a training run may be asked for (the paper preset runs 400001).
 constexpr int64_t kMaxSteps = 100000000;

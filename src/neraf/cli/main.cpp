@@ -4,7 +4,9 @@
 #include <malloc.h>
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <new>
 #include <string>
 
@@ -94,6 +96,15 @@ int main(int argc, char** argv) {
       return 1;
     }
     std::fprintf(stderr, "error: %s\n", what.c_str());
+    return 1;
+  }
+  // What went to standard output (--json, --print-scene) must have arrived: `> file` on a full
+  // disk fails here, not silently.
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    std::fprintf(stderr,
+                 "error: cannot write to standard output (%s); free disk space or "
+                 "redirect it elsewhere\n",
+                 std::strerror(errno));
     return 1;
   }
   return 0;

@@ -194,6 +194,8 @@ void add_render_rir(CLI::App& render) {
       if (pose_opts.first->count() == 0) throw CLI::RequiredError("--mic (or --poses)");
       if (pose_opts.second->count() == 0) throw CLI::RequiredError("--src (or --poses)");
     }
+    if (poses_opt->count() == 0)
+      require_safe_output({"--out", args->out}, {{"--model", args->field.model}}, args->field.run);
     const LoadedField field = load_field(args->field);
     if (poses_opt->count() > 0) {
       render_pose_list(field, args->field, args->pose, args->poses, args->out);
@@ -242,6 +244,9 @@ void add_render_loudness(CLI::App& render) {
   cmd->callback([args] {
     if (args->threads > 0) torch::set_num_threads(args->threads);
     const geometry::Vec3 src = parse_flag_position(args->pose.src, "--src");
+    require_safe_output({"--out", args->out}, {{"--csv", args->csv}, {"--model", args->field.model}},
+                        args->field.run);
+    require_safe_output({"--csv", args->csv}, {{"--model", args->field.model}}, args->field.run);
     const LoadedField field = load_field(args->field);
     const infer::AudioRunInfo& info = field.field->info();
     const double yaw = resolve_yaw(args->pose, info.layout, field.name);

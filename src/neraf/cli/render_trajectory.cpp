@@ -248,7 +248,11 @@ void add_render_trajectory(CLI::App& render) {
   cmd->add_option("--fps", args->fps, "Video frames per second for --frames")
       ->check(real_number(0.01, 120))
       ->capture_default_str();
-  cmd->callback([args] { run_trajectory(*args); });
+  cmd->callback([args] {
+    require_safe_output({"--out", args->out}, {{"--in", args->dry}, {"--model", args->field.model}},
+                        args->field.run);
+    run_trajectory(*args);
+  });
 }
 
 }  // namespace neraf::cli

@@ -177,13 +177,13 @@ void register_train(CLI::App& app) {
   cmd->add_option("--keep", args->keep,
                   "Checkpoints to keep, the newest (0: keep all; older ones are deleted as new "
                   "ones are written)")
-      ->check(CLI::Range(0, 1000000))
+      ->transform(whole_number(0, 1000000))
       ->capture_default_str();
   CLI::Option* save_every =
       cmd->add_option("--save-every", args->save_every,
                       "Write a checkpoint every N steps (default: the preset's, 500 for cpu; "
                       "may change on --resume)")
-          ->check(CLI::Range(int64_t{1}, int64_t{1000000000}));
+          ->transform(whole_number(1, kMaxSteps));
 
   cmd->callback([args, data, preset, steps, seed, threads, rays, precision, grid, fraction,
                  vision_run, audio_start, decay_loss, no_relative, save_every]() {

@@ -108,7 +108,7 @@ double wrap_deg(double deg) {
 }
 
 double read_yaw(const std::string& where, const json& j, const std::string& path) {
-  const std::string what = "must be a number of degrees (the orientation, as --yaw / --src-yaw)";
+  const std::string what = "must be a number of degrees (a heading)";
   if (!j.is_number()) fail(where, path, what);
   const double v = j.get<double>();
   if (!std::isfinite(v)) fail(where, path, what + ", finite");

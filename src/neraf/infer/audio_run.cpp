@@ -138,7 +138,8 @@ acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, in
 }
 
 std::vector<int64_t> audio_train_subset(const data::RirSet& rirs, double fraction, uint64_t seed) {
-  require(fraction > 0 && fraction <= 1, "--audio-fraction: must be in (0, 1]");
+  require(fraction > 0 && fraction <= 1, "the audio fraction (neraf train --audio-fraction) must be in (0, 1], not " +
+                                               std::to_string(fraction));
   std::vector<int64_t> all = rirs.train;
   if (fraction >= 1.0 || all.empty()) return all;
   const int64_t n = static_cast<int64_t>(all.size());

@@ -210,13 +210,13 @@ nlohmann::json check_checkpoint_header(torch::serialize::InputArchive& a, const 
   if (stored.value("preset", "") != config.preset)
     throw Error(path + ": checkpoint was trained with --preset " + stored.value("preset", "?") +
                 ", this run uses --preset " + config.preset +
-                "; use the same preset or a new --out folder");
+                "; it belongs to another run folder (to train another preset, start a new run)");
   // Keys newer than the checkpoint take their preset defaults, as when config.json is read.
   const nlohmann::json stored_full = to_json(train_config_from_json(stored, path));
   const std::string diff = first_difference(comparable(stored_full), comparable(mine));
   if (!diff.empty())
     throw Error(path + ": checkpoint was trained with a different config (" + diff +
-                " differs); use the run's own config.json or a new --out folder");
+                " differs); it belongs to another run folder, or the run's config.json was edited");
   return stored;
 }
 

@@ -35,13 +35,21 @@ void create_parent(const fs::path& target, const std::string& what) {
 
 const char* kind_of(fs::file_type t) {
   switch (t) {
-    case fs::file_type::symlink: return "a symbolic link";
-    case fs::file_type::fifo: return "a FIFO";
+    case fs::file_type::symlink:
+      return "a symbolic link";
+    case fs::file_type::fifo:
+      return "a FIFO";
     case fs::file_type::block:
-    case fs::file_type::character: return "a device";
-    case fs::file_type::socket: return "a socket";
-    case fs::file_type::directory: return "a folder";
-    default: return "not a regular file";
+    case fs::file_type::character:
+      return "a device";
+    case fs::file_type::socket:
+      return "a socket";
+    case fs::file_type::directory:
+      return "a folder";
+    case fs::file_type::regular:
+      return "a file";
+    default:
+      return "not a regular file";
   }
 }
 
@@ -78,7 +86,8 @@ void sync_path(const std::string& path) {
                                         "); free space or check the disk");
 }
 
-void write_atomically(const std::string& path, const std::function<void(const std::string&)>& write) {
+void write_atomically(const std::string& path,
+                      const std::function<void(const std::string&)>& write) {
   const fs::path target(path);
   create_parent(target, path);
   require_replaceable_file(path);
@@ -94,7 +103,8 @@ void write_atomically(const std::string& path, const std::function<void(const st
   fs::rename(tmp, target, ec);
   if (ec) {
     fs::remove(tmp, ec);
-    throw Error(path + ": cannot write the file (" + ec.message() + "); choose a writable output path");
+    throw Error(path + ": cannot write the file (" + ec.message() +
+                "); choose a writable output path");
   }
   sync_path(parent_or_dot(target).string());
 }
@@ -115,13 +125,14 @@ void write_text_atomically(const std::string& path, const std::string& text) {
       }
       done += static_cast<size_t>(n);
     }
-    require(::close(fd) == 0, path + ": write failed (" + std::strerror(errno) +
-                                  "); free space and retry");
+    require(::close(fd) == 0,
+            path + ": write failed (" + std::strerror(errno) + "); free space and retry");
   });
 }
 
 void write_folder_atomically(const std::string& dir,
-                             const std::function<void(const std::string&)>& write, bool replace) {
+                             const std::function<void(const std::string&)>& write,
+                             FolderWrite mode) {
   fs::path target = fs::path(dir).lexically_normal();
   if (target.filename().empty()) target = target.parent_path();  // "out/" → "out"
   create_parent(target, dir);
@@ -133,7 +144,7 @@ void write_folder_atomically(const std::string& dir,
   if (exists) {
     require(fs::is_directory(st), dir + ": exists and is " + std::string(kind_of(st.type())) +
                                       ", not a folder; remove it or choose another output folder");
-    require(replace || fs::is_empty(target, ec),
+    require(mode != FolderWrite::create || fs::is_empty(target, ec),
             dir + ": folder exists and is not empty; choose a new output folder");
   }
   const std::string name = target.filename().string();
@@ -148,6 +159,21 @@ void write_folder_atomically(const std::string& dir,
   } catch (...) {
     fs::remove_all(tmp, ec);
     throw;
+  }
+  if (exists && mode == FolderWrite::merge) {
+    for (const auto& entry : fs::directory_iterator(tmp, ec)) {
+      const fs::path to = target / entry.path().filename();
+      require_replaceable_file(to.string());
+      fs::rename(entry.path(), to, ec);
+      if (ec) {
+        const std::string why = ec.message();
+        fs::remove_all(tmp, ec);
+        throw Error(to.string() + ": cannot move the finished file into place (" + why + ")");
+      }
+    }
+    fs::remove_all(tmp, ec);
+    sync_path(target.string());
+    return;
   }
   // The old folder is moved aside, not deleted, until the new one is in place.
   const fs::path old = parent / ("." + name + ".old" + pid_suffix());
@@ -179,7 +205,8 @@ int remove_stale_temporaries(const std::string& folder) {
     std::smatch m;
     if (!std::regex_search(name, m, kTemporary)) continue;
     const pid_t pid = static_cast<pid_t>(std::stol(m[1].str()));
-    if (pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH) continue;  // alive (or not ours to judge)
+    if (pid == ::getpid() || ::kill(pid, 0) == 0 || errno != ESRCH)
+      continue;  // alive (or not ours to judge)
     std::error_code rm;
     if (fs::remove_all(entry.path(), rm) > 0 && !rm) ++removed;
   }
@@ -190,6 +217,8 @@ std::string read_text_file(const std::string& path) {
   std::error_code ec;
   require(fs::exists(path, ec), path + ": no such file; check the path");
   require(!fs::is_directory(path, ec), path + ": is a folder, expected a file");
+  // A FIFO or device would block the read (or never end).
+  require(fs::is_regular_file(path, ec), path + ": is not a regular file; expected a file");
   std::ifstream in(path, std::ios::binary);
   require(in.good(), path + ": cannot open (" + std::strerror(errno) + "); check its permissions");
   std::ostringstream ss;

@@ -12,18 +12,26 @@ namespace neraf::io {
 
 // Calls write(tmp_path) and renames tmp_path to path. The parent folder is created if missing.
 // If `write` throws, the temporary file is removed and the exception propagates.
-void write_atomically(const std::string& path, const std::function<void(const std::string&)>& write);
+void write_atomically(const std::string& path,
+                      const std::function<void(const std::string&)>& write);
 
 // Writes `text` (any bytes) to `path` atomically; a short write (disk full) is a neraf::Error.
 void write_text_atomically(const std::string& path, const std::string& text);
 
+// What write_folder_atomically does with an existing folder.
+enum class FolderWrite {
+  create,   // an error unless it is empty
+  replace,  // swapped out, and deleted only once the new folder is in place
+  merge,    // each new file is renamed over its namesake; other files stay
+};
+
 // Builds the folder `dir` through write(tmp_dir) in a temporary folder beside it, fsyncs what
-// was written and renames it into place. An existing `dir` is an error unless it is empty or
-// `replace` is set (then the old folder is swapped out and deleted only after the new one is in
-// place). If `write` throws, the temporary folder is removed and the exception propagates.
+// was written and renames it into place (or, for merge, renames its files into `dir`). If
+// `write` throws, the temporary folder is removed, `dir` is as it was, and the exception
+// propagates.
 void write_folder_atomically(const std::string& dir,
                              const std::function<void(const std::string&)>& write,
-                             bool replace = false);
+                             FolderWrite mode = FolderWrite::create);
 
 // neraf::Error unless `path` is absent or a regular file (what write_atomically may replace).
 void require_replaceable_file(const std::string& path);

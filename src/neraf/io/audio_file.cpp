@@ -184,7 +184,12 @@ void write_audio(const std::string& path, const AudioBuffer& audio, AudioFormat 
   }
 
   if (format == AudioFormat::from_extension) {
-    format = lower_extension(path) == ".flac" ? AudioFormat::flac_pcm24 : AudioFormat::wav_float;
+    const std::string ext = lower_extension(path);
+    // Anything else would be a WAV under a misleading name (an ".mp3" that is not MP3).
+    require(ext.empty() || ext == ".wav" || ext == ".flac",
+            path + ": neraf writes WAV (.wav) or FLAC (.flac) files, not " + ext +
+                "; change the file's extension");
+    format = ext == ".flac" ? AudioFormat::flac_pcm24 : AudioFormat::wav_float;
   }
   int sf_format = 0;
   switch (format) {

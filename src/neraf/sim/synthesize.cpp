@@ -276,7 +276,7 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
   io::write_folder_atomically(
       options.out_dir,
       [&](const std::string& tmp) { sum = write_dataset(scene, options, plan, tmp); },
-      options.force);
+      options.force ? io::FolderWrite::replace : io::FolderWrite::create);
   sum.out_dir = options.out_dir;
   sum.total_seconds = seconds_since(t_start);
   return sum;

@@ -92,8 +92,8 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
     if (fs::is_regular_file(manifest_path, ec)) old_manifest = io::read_json(manifest_path);
     const bool any = !infer::checkpoints_newest_first(options.run_dir).empty();
     resume_from = newest_intact_checkpoint(options.run_dir);
-    require(resume_from || !any, options.run_dir +
-                                     ": every checkpoint is damaged; start over with --force");
+    require(resume_from || !any,
+            options.run_dir + ": every checkpoint is damaged; start over with --force");
     if (!resume_from) warn(options.run_dir + ": no checkpoint yet; starting from step 0");
   } else if (folder_has_entries(run)) {
     require(options.force, options.run_dir +
@@ -129,7 +129,7 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
   if (cfg.modality != Modality::vision) {
     data::RirLoadOptions rload;
     rload.progress = options.progress;
-    rload.stop = options.stop;  // Ctrl-C stops a feature-cache build too
+    rload.stop = options.stop;              // Ctrl-C stops a feature-cache build too
     rload.cache_dir = cfg.audio.cache_dir;  // --cache-dir, --cache-precision (recorded in config)
     rload.half_precision = data::parse_cache_precision(cfg.audio.cache_precision);
     rirs = std::make_unique<data::RirSet>(data::load_rir_set(data_dir, rload));
@@ -256,6 +256,8 @@ TrainRunSummary run_training(const TrainConfig& config, const TrainRunOptions& o
     // A refused or failed run leaves no folder behind that it created and wrote no checkpoint to.
     if (created && infer::checkpoints_newest_first(options.run_dir).empty())
       fs::remove_all(options.run_dir, ec);
+    else if (!fs::exists(fs::path(options.run_dir) / "config.json", ec))  // not a run: no lock
+      fs::remove(fs::path(options.run_dir) / io::FolderLock::kFileName, ec);
     throw;
   }
 }
