@@ -345,6 +345,17 @@ bad "--in" "$NERAF" render trajectory --model "$BASE/model.nrf" \
 bad "not .mp3" "$NERAF" auralize --rir "$WAV" --in "$DRY" --out @OUT@.mp3
 bad "--ablation-runs" "$NERAF" eval --run "$BASE/run" --json @OUT@ --skip-vision \
   --ablation-runs "$BASE/run,$BASE/run"
+# A checkpoint copied in under another step's name, a gain from a set of the other layout, a
+# JSON key given twice.
+last=$(ls "$BASE"/run/checkpoints/step-*[0-9].pt | tail -1)
+cp "$last" "$BASE/run/checkpoints/step-000099999.pt"
+bad "step-000099999.pt" "$NERAF" render rir --run "$BASE/run" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 \
+  --out @OUT@
+rm "$BASE/run/checkpoints/step-000099999.pt"
+bad "--gain-from" "$NERAF" synth --preset demo --layout soundspaces --gain-from "$BASE/raf" \
+  --out @OUT@ --quiet
+echo '{"room": {"size": [4, 3, 5], "size": [9, 9, 9]}}' >"$TMP/twice.json"
+bad "appears twice" "$NERAF" synth --scene "$TMP/twice.json" --out @OUT@ --quiet
 run "$NERAF" info "$BASE/ss" --json
 [ "$got" -eq 0 ] || fail "info --json on a good set exited $got"
 timeout 60 "$NERAF" info "$BASE/ss" --json >/dev/full 2>"$TMP/err"

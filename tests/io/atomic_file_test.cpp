@@ -201,6 +201,23 @@ TEST_F(AtomicFileTest, FolderLockRefusesASecondWriterAndNamesThePid) {
   EXPECT_NO_THROW(FolderLock again(dir_.string()));  // released with the first
 }
 
+TEST_F(AtomicFileTest, JsonKeyGivenTwiceIsAnError) {
+  fs::create_directories(dir_);
+  const std::string twice = (dir_ / "twice.json").string();
+  write_text_atomically(twice, R"({"room": {"size": [4, 3, 5], "size": [9, 9, 9]}})");
+  try {
+    read_json(twice);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("twice.json: the key \"size\" appears twice"),
+              std::string::npos)
+        << e.what();
+  }
+  // The same key in different objects is fine.
+  write_text_atomically(twice, R"({"a": {"size": 1}, "b": {"size": 2}, "c": [{"k": 1}, {"k": 2}]})");
+  EXPECT_EQ(read_json(twice)["b"]["size"], 2);
+}
+
 TEST_F(AtomicFileTest, JsonRoundTrip) {
   const std::string path = (dir_ / "x.json").string();
   nlohmann::json value = {{"fs", 22050}, {"channels", {1.5, 2.5}}};

@@ -8,6 +8,7 @@
 
 #include "neraf/cli/commands.h"
 #include "neraf/cli/flag_checks.h"
+#include "neraf/io/json_file.h"
 #include "neraf/sim/presets.h"
 #include "neraf/sim/scene_json.h"
 #include "neraf/sim/synthesize.h"
@@ -75,6 +76,12 @@ void run_synth(const SynthArgs& a) {
     require(gain.has_value(), "--gain-from " + a.gain_from +
                                   ": no synth_info.json; give a folder written by neraf synth");
     opt.gain = *gain;
+    // A binaural and a mono set are not at one scale (the HRTF changes the level).
+    const std::string info_path = a.gain_from + "/synth_info.json";
+    const std::string other = io::read_json(info_path).value("layout", std::string());
+    require(other.empty() || other == a.layout,
+            "--gain-from " + a.gain_from + ": is a " + other + " set; give a " + a.layout +
+                " set of the same room (--layout " + a.layout + ")");
   }
   const sim::SynthSummary s = sim::synthesize(scene, opt);
 

@@ -74,13 +74,15 @@ void load_archive(torch::serialize::InputArchive& archive, const std::string& pa
   const std::string file = io::read_text_file(path);
   const std::string fix = "; delete it to resume from the previous checkpoint";
   try {
-    if (io::has_magic(file, "PK\x03\x04")) {  // a zip archive: written before checkpoints were sealed
+    if (io::has_magic(file,
+                      "PK\x03\x04")) {  // a zip archive: written before checkpoints were sealed
       archive.load_from(file.data(), file.size());
       return;
     }
     require(io::has_magic(file, kSealMagic),
-            path + ": not a neraf checkpoint (unknown format); point at a file written by "
-                   "neraf train");
+            path +
+                ": not a neraf checkpoint (unknown format); point at a file written by "
+                "neraf train");
     const io::Unsealed sealed = io::unseal(file, kSealMagic, kSealVersion, path);
     archive.load_from(sealed.payload.data(), sealed.payload.size());
   } catch (const Error& e) {
@@ -201,6 +203,15 @@ nlohmann::json check_checkpoint_header(torch::serialize::InputArchive& a, const 
     c10::IValue cfg;
     a.read("config", cfg);
     stored = nlohmann::json::parse(cfg.toStringRef());
+    // A checkpoint copied in from another run under another step's name would load as this
+    // run's (found by probing: the same config and dataset pass every other check).
+    torch::Tensor step;
+    a.read("step", step);
+    const int64_t named = checkpoint_step_from_name(path);
+    require(named < 0 || (step.numel() == 1 && step.item<int64_t>() == named),
+            path + ": holds step " + std::to_string(step.numel() == 1 ? step.item<int64_t>() : -1) +
+                ", not the step its name says (copied from another run?); use the run's own "
+                "checkpoints");
   } catch (const c10::Error&) {
     throw Error(path + ": checkpoint header is unreadable (corrupted file); delete it");
   } catch (const nlohmann::json::exception&) {
