@@ -62,26 +62,6 @@ inline void write_wav(const std::string& path, int fs, const std::vector<std::ve
   io::write_audio(path, a, format);
 }
 
-// A RIFF/WAVE float32 file with a header and no samples (SoundSpaces ships some of these).
-inline void write_empty_wav(const std::string& path, int fs, int channels) {
-  fs::create_directories(fs::path(path).parent_path());
-  std::ofstream out(path, std::ios::binary);
-  auto u32 = [&](uint32_t v) { out.write(reinterpret_cast<const char*>(&v), 4); };
-  auto u16 = [&](uint16_t v) { out.write(reinterpret_cast<const char*>(&v), 2); };
-  out.write("RIFF", 4);
-  u32(36);
-  out.write("WAVEfmt ", 8);
-  u32(16);
-  u16(3);  // IEEE float
-  u16(static_cast<uint16_t>(channels));
-  u32(static_cast<uint32_t>(fs));
-  u32(static_cast<uint32_t>(fs * channels * 4));
-  u16(static_cast<uint16_t>(channels * 4));
-  u16(32);
-  out.write("data", 4);
-  u32(0);
-}
-
 // A RIFF/WAVE float32 file holding exactly `interleaved` ([frame][channel]) whose header announces
 // `declared_frames` (0: as many as given). Unlike write_wav it writes what damaged files hold:
 // NaN or huge samples, and headers promising more samples than are there.
@@ -109,6 +89,11 @@ inline void write_raw_float_wav(const std::string& path, int fs, int channels,
   u32(data_bytes);
   out.write(reinterpret_cast<const char*>(interleaved.data()),
             static_cast<std::streamsize>(interleaved.size() * sizeof(float)));
+}
+
+// A RIFF/WAVE float32 file with a header and no samples (SoundSpaces ships some of these).
+inline void write_empty_wav(const std::string& path, int fs, int channels) {
+  write_raw_float_wav(path, fs, channels, {});
 }
 
 // numpy.save of a float32 C-order array (format 1.0).
