@@ -205,7 +205,8 @@ TEST(SoundSpaces, PublishedMagnitudeFilesAreUsedWhenPresent) {
         {2, 257, t}, v);
   }
   const RirSet set = load_soundspaces(dir.path(), quiet());
-  EXPECT_EQ(set.max_len, 20 + 7 * 6);  // the longest magnitude file
+  // The longest training magnitude file (entries 5 and 6, 55 and 62 frames, are test RIRs: cut).
+  EXPECT_EQ(set.max_len, 20 + 7 * 4);
   for (size_t i = 0; i < mags.size(); ++i) {
     EXPECT_FALSE(set.rirs[i].magnitude_path.empty());
     const float mn = mags[i].min().item<float>();
@@ -217,6 +218,44 @@ TEST(SoundSpaces, PublishedMagnitudeFilesAreUsedWhenPresent) {
   const RirSet from_wav = load_soundspaces(dir.path(), o);
   EXPECT_TRUE(from_wav.rirs[0].magnitude_path.empty());
   EXPECT_EQ(from_wav.max_len, 81);
+}
+
+TEST(SoundSpaces, AutomaticMaxLenIsTheLongestTrainingRir) {
+  TempDir dir;
+  SoundSpacesScene scene;
+  scene.entries[5].samples = 30001;  // a test RIR longer than every training RIR
+  scene.write(dir.path());
+  const RirSet set = load_soundspaces(dir.path(), quiet());
+  EXPECT_EQ(set.max_len, 81);  // the 20001-sample training RIR, as before
+  EXPECT_EQ(set.max_len_source, "longest training RIR");
+  EXPECT_TRUE(set.max_len_note.empty());
+  EXPECT_GT(set.rirs[5].num_frames, 81);  // its own length is kept; its features are cut
+  EXPECT_EQ(set.features(5).size(2), 81);
+}
+
+TEST(SoundSpaces, PublishedSceneUsesThePublishedMaxLenWithANote) {
+  EXPECT_EQ(published_max_len("office_4"), 78);
+  EXPECT_EQ(published_max_len("frl_apartment_2"), 107);
+  EXPECT_FALSE(published_max_len("office_5").has_value());
+  TempDir dir;
+  const std::string root = dir.path() + "/office_4";
+  SoundSpacesScene scene;
+  scene.write(root);
+  for (const std::string& path : {root, root + "/"}) {
+    const RirSet set = load_soundspaces(path, quiet());
+    EXPECT_EQ(set.max_len, 78);
+    EXPECT_EQ(set.waveform_length, 78 * 128);
+    EXPECT_EQ(set.max_len_source, "published (office_4)");
+    // The data's own value (81) differs: said, with the flag that selects it.
+    EXPECT_NE(set.max_len_note.find("81 frames"), std::string::npos) << set.max_len_note;
+    EXPECT_NE(set.max_len_note.find("--max-len 81"), std::string::npos) << set.max_len_note;
+  }
+  RirLoadOptions o = quiet();
+  o.max_len = 81;
+  const RirSet explicit_len = load_soundspaces(root, o);
+  EXPECT_EQ(explicit_len.max_len, 81);
+  EXPECT_EQ(explicit_len.max_len_source, "--max-len");
+  EXPECT_TRUE(explicit_len.max_len_note.empty());
 }
 
 TEST(SoundSpaces, EmptyWavIsSilence) {
@@ -377,6 +416,22 @@ TEST(Raf, PosesYawSplitsFeaturesAndWaveforms) {
   EXPECT_NEAR(set.audio_aabb.min.x, -0.5, 1e-12);
   EXPECT_NEAR(set.audio_aabb.max.x, 3.0, 1e-12);
   EXPECT_NEAR(set.audio_aabb.max.z, 3.5, 1e-12);
+}
+
+TEST(Raf, MaxLenOtherThanThePublished60IsRefused) {
+  TempDir dir;
+  RafRoom room;
+  room.write(dir.path());
+  RirLoadOptions o = quiet();
+  o.max_len = 60;
+  EXPECT_EQ(load_raf(dir.path(), o).max_len, 60);
+  o.max_len = 80;
+  try {
+    load_raf(dir.path(), o);
+    FAIL() << "a RAF max_len of 80 was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("SoundSpaces-layout data only"), std::string::npos);
+  }
 }
 
 TEST(Raf, StringIdsAndWrongSampleRate) {

@@ -41,6 +41,7 @@ void run_calibrate(const CalibrateArgs& args) {
   load.cache_dir = args.cache_dir_opt->count() ? args.cache_dir : cfg.audio.cache_dir;
   load.half_precision = data::parse_cache_precision(
       args.cache_precision.empty() ? cfg.audio.cache_precision : args.cache_precision);
+  load.max_len = cfg.audio.max_len;  // as training loaded it (0: automatic)
   const std::string data_dir = args.data.empty() ? manifest["data"].get<std::string>() : args.data;
   const data::RirSet rirs = data::load_rir_set(data_dir, load);
   const std::string path = infer::calibrate_run(args.run_dir, rirs, args.checkpoint);

@@ -122,13 +122,16 @@ nlohmann::json score_audio(const infer::AudioField& run,
 struct CacheChoice {
   std::string dir;
   std::string precision = "fp32";
+  int64_t max_len = 0;  // the run's --max-len (0: automatic, as training resolved it)
 };
 
-data::RirSet load_rirs(const std::string& dir, bool progress, const CacheChoice& cache) {
+data::RirSet load_rirs(const std::string& dir, bool progress, const CacheChoice& cache,
+                       int64_t max_len) {
   data::RirLoadOptions load;
   load.progress = progress;
   load.cache_dir = cache.dir;
   load.half_precision = data::parse_cache_precision(cache.precision);
+  load.max_len = max_len;
   return data::load_rir_set(dir, load);
 }
 
@@ -165,7 +168,8 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
   CacheChoice cache = source.cache;
   if (args.cache_dir_opt && args.cache_dir_opt->count()) cache.dir = args.cache_dir;
   if (!args.cache_precision.empty()) cache.precision = args.cache_precision;
-  const data::RirSet rirs = load_rirs(data_dir, !args.quiet, cache);
+  // The run's data as training loaded it (same options, same cache file).
+  const data::RirSet rirs = load_rirs(data_dir, !args.quiet, cache, cache.max_len);
   infer::check_audio_manifest(source.manifest.at("audio"), rirs, data_dir);
   std::vector<std::pair<std::string, infer::AudioRun>> ablations;
   std::set<std::string> labels;  // the table's and the JSON's name of each: its folder's name
@@ -192,7 +196,8 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
   // Checked before anything is scored or written.
   std::optional<data::RirSet> novel;
   if (!args.novel_data.empty()) {
-    novel = load_rirs(args.novel_data, !args.quiet, cache);
+    // Cut or padded to the run's frames, whatever the set's own automatic value would be.
+    novel = load_rirs(args.novel_data, !args.quiet, cache, rirs.max_len);
     infer::check_same_room_format(source.manifest.at("audio"), *novel, args.novel_data);
     check_same_gain(data_dir, args.novel_data);
   }
@@ -370,7 +375,8 @@ void register_eval(CLI::App& app) {
                 audio.run().config.seed,
                 audio.run().config.audio.fraction,
                 audio.run().config.audio.grid,
-                {audio.run().config.audio.cache_dir, audio.run().config.audio.cache_precision}};
+                {audio.run().config.audio.cache_dir, audio.run().config.audio.cache_precision,
+                 audio.run().config.audio.max_len}};
             out["audio"] = evaluate_audio_json(source, *args, dir);
           }
           if (!args->skip_vision) {

@@ -170,17 +170,41 @@ std::string sanitize(std::string s) {
   return s.empty() ? "dataset" : s;
 }
 
+// The dataset folder's own name ("office_4" for "data/office_4/" and for "." inside it).
+std::string folder_name(const std::string& root) {
+  const fs::path p = fs::absolute(root).lexically_normal();
+  return p.has_filename() ? p.filename().string() : p.parent_path().filename().string();
+}
+
 void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& options) {
   const bool ss = set.layout == AudioLayout::soundspaces;
   const bool npy = ss && idx.use_npy;
   const int64_t n = set.size();
 
+  // Frames per RIR: the option, RAF's fixed 0.32 s, a published scene's value, else (0 here) the
+  // longest training RIR, read from the headers when the cache is built.
+  const std::string scene = folder_name(set.root);
+  const std::optional<int64_t> published = ss ? published_max_len(scene) : std::nullopt;
+  int64_t max_len = 0;
+  if (options.max_len > 0) {
+    max_len = options.max_len;
+    set.max_len_source = "--max-len";
+  } else if (!ss) {
+    max_len = detail::kRafMaxLen;
+    set.max_len_source = "RAF 0.32 s";
+  } else if (published) {
+    max_len = *published;
+    set.max_len_source = "published (" + scene + ")";
+  } else {
+    set.max_len_source = "longest training RIR";
+  }
+
   // What the features depend on: recipe, parameters, and each source file's identity.
   std::ostringstream params;
   params << "neraf-features v1\nlayout " << to_string(set.layout) << "\nsource "
          << (npy ? "npy-magnitudes" : "wav") << "\nmax_len "
-         << (options.max_len > 0 ? std::to_string(options.max_len) : "auto") << "\nstft "
-         << set.stft.n_fft << " " << set.stft.win_length << " " << set.stft.hop_length
+         << (max_len > 0 ? std::to_string(max_len) : "longest-train") << "\nstft " << set.stft.n_fft
+         << " " << set.stft.win_length << " " << set.stft.hop_length
          << (set.stft.center ? " center" : "") << "\nsample_rate " << set.sample_rate
          << "\nlog_eps 1e-3\ndtype " << (options.half_precision ? "float16" : "float32")
          << "\nn_rirs " << n << "\n";
@@ -199,7 +223,7 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
   spec.n_rirs = n;
   spec.channels = set.channels;
   spec.n_freq = set.n_freq;
-  spec.max_len = options.max_len > 0 ? options.max_len : (ss ? 0 : detail::kRafMaxLen);
+  spec.max_len = max_len;
   spec.half = options.half_precision;
 
   // Where: the user's folder, else <root>/.neraf_cache, else the user cache folder.
@@ -220,11 +244,7 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
   require(writable_dir(dir), dir +
                                  ": cannot create or write the feature cache folder; pass a "
                                  "writable --cache-dir");
-  const std::string prefix =
-      sanitize(fs::path(set.root).lexically_normal().filename().string().empty()
-                   ? fs::absolute(set.root).parent_path().filename().string()
-                   : fs::path(set.root).lexically_normal().filename().string()) +
-      "_" + spec.layout + "_";
+  const std::string prefix = sanitize(scene) + "_" + spec.layout + "_";
   const std::string path = (fs::path(dir) / (prefix + spec.key + ".bin")).string();
 
   std::shared_ptr<FeatureCache> cache = FeatureCache::open(path, spec);
@@ -233,16 +253,17 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
     // was made from these very files, checked then: the key hashes their size and time).
     std::vector<detail::RirHeader> headers;
     ProblemList problems = detail::check_rir_headers(set, headers);
-    std::vector<int64_t> frames(static_cast<size_t>(n), 0);
-    for (int64_t i = 0; i < n; ++i) frames[i] = headers[i].stft_frames;
-    // SoundSpaces automatic max_len: the longest STFT over all RIRs, from the headers only,
-    // bounded before a byte of the cache is written.
-    if (spec.max_len == 0) detail::check_padded_cache_size(set, frames, spec.half, problems);
+    // SoundSpaces automatic max_len: the longest STFT among the training RIRs (0 for the others),
+    // from the headers only, bounded before a byte of the cache is written.
+    std::vector<int64_t> train_frames(static_cast<size_t>(n), 0);
+    for (int64_t i : set.train) train_frames[size_t(i)] = headers[size_t(i)].stft_frames;
+    if (spec.max_len == 0) detail::check_padded_cache_size(set, train_frames, spec.half, problems);
     problems.throw_if_errors(set.root);
     if (options.progress) problems.print_warnings();
     if (spec.max_len == 0)
-      spec.max_len = std::max<int64_t>(1, *std::max_element(frames.begin(), frames.end()));
-    const int64_t max_len = spec.max_len;
+      spec.max_len =
+          std::max<int64_t>(1, *std::max_element(train_frames.begin(), train_frames.end()));
+    max_len = spec.max_len;
     const double gb = detail::cache_bytes(set, max_len, spec.half) / 1e9;
     char msg[160];
     std::snprintf(msg, sizeof msg,
@@ -292,6 +313,16 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
     }
   }
   set.max_len = cache->spec().max_len;
+  if (published && options.max_len <= 0) {
+    int64_t longest = 0;
+    for (int64_t i : set.train) longest = std::max<int64_t>(longest, cache->own_length(i));
+    if (longest != *published) {
+      set.max_len_note = "max_len " + std::to_string(*published) + " is the published value for " +
+                         scene + "; the longest training RIR here has " + std::to_string(longest) +
+                         " frames (pass --max-len " + std::to_string(longest) + " to use it)";
+      if (options.progress) info(set.root + ": " + set.max_len_note);
+    }
+  }
   set.cache_path = path;
   set.waveform_length = ss ? set.max_len * set.stft.hop_length : detail::kRafSamples;
   for (int64_t i = 0; i < n; ++i) set.rirs[i].num_frames = cache->own_length(i);
@@ -305,7 +336,11 @@ RirSet load(const std::string& dir, AudioLayout layout, const RirLoadOptions& op
   if (options.progress) problems.print_warnings();
   RirSet set = std::move(idx.set);
   if (set.layout == AudioLayout::raf) {
-    set.max_len = options.max_len > 0 ? options.max_len : detail::kRafMaxLen;
+    require(options.max_len <= 0 || options.max_len == detail::kRafMaxLen,
+            dir + ": a RAF-layout dataset has " + std::to_string(detail::kRafMaxLen) +
+                " frames per RIR (0.32 s, as published); --max-len applies to SoundSpaces-layout "
+                "data only");
+    set.max_len = detail::kRafMaxLen;
     set.waveform_length = detail::kRafSamples;
   } else if (options.max_len > 0) {
     set.max_len = options.max_len;
@@ -340,6 +375,15 @@ RirSet load_soundspaces(const std::string& dir, const RirLoadOptions& options) {
 
 RirSet load_raf(const std::string& dir, const RirLoadOptions& options) {
   return load(dir, AudioLayout::raf, options);
+}
+
+std::optional<int64_t> published_max_len(const std::string& scene_name) {
+  static const std::pair<const char*, int64_t> kPublished[] = {
+      {"office_4", 78},    {"room_2", 84},           {"apartment_1", 101},
+      {"apartment_2", 86}, {"frl_apartment_2", 107}, {"frl_apartment_4", 103}};
+  for (const auto& [name, frames] : kPublished)
+    if (scene_name == name) return frames;
+  return std::nullopt;
 }
 
 bool parse_cache_precision(const std::string& text, const std::string& flag) {

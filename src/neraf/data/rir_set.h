@@ -22,6 +22,7 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -66,9 +67,9 @@ struct Rir {
 };
 
 struct RirLoadOptions {
-  // Frames per RIR. 0 = automatic: RAF 60 (0.32 s); SoundSpaces the longest STFT over all RIRs of
-  // the split (train and test), which we believe is how the published per-scene values (office_4
-  // 78 ... frl_apartment_2 107) were chosen.
+  // Frames per RIR. 0 = automatic: RAF 60 (0.32 s); SoundSpaces the published value when the
+  // dataset folder is named after a published scene (published_max_len), else the longest STFT
+  // among the training RIRs (longer test RIRs are cut, as the reference cuts them).
   int64_t max_len = 0;
   bool load_features = true;    // false: poses and splits only (fast; features()/gather() throw)
   std::string cache_dir;        // "" = <scene>/.neraf_cache (falls back to ~/.cache/neraf/<hash>
@@ -95,6 +96,10 @@ struct RirSet {
   dsp::StftParams stft;         // soundspaces() / raf()
   int64_t n_freq = 0;           // 257 / 513
   int64_t max_len = 0;          // frames per RIR
+  std::string max_len_source;   // how max_len was chosen: "--max-len", "published (office_4)",
+                                // "longest training RIR", "RAF 0.32 s"
+  std::string max_len_note;     // non-empty when the published value differs from the longest
+                                // training RIR (printed when loading, kept in the run's data.json)
   int64_t waveform_length = 0;  // eval ground truth: max_len·128 (SoundSpaces) / 15360 (RAF)
 
   std::vector<Rir> rirs;             // train RIRs first (split order), then test
@@ -123,6 +128,11 @@ struct RirSet {
 
   std::shared_ptr<const FeatureCache> cache_;  // memory-mapped features (shared by copies)
 };
+
+// SoundSpaces frames per RIR of the scenes the NeRAF paper trains on (office_4 78, room_2 84,
+// apartment_1 101, apartment_2 86, frl_apartment_2 107, frl_apartment_4 103), by the name of the
+// scene's folder; nullopt for any other name.
+std::optional<int64_t> published_max_len(const std::string& scene_name);
 
 // Detects the layout (SoundSpaces or RAF) of `dir` and loads it; throws neraf::Error listing the
 // first problem (and how many more) when the dataset is broken.

@@ -132,6 +132,7 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
     rload.stop = options.stop;              // Ctrl-C stops a feature-cache build too
     rload.cache_dir = cfg.audio.cache_dir;  // --cache-dir, --cache-precision (recorded in config)
     rload.half_precision = data::parse_cache_precision(cfg.audio.cache_precision);
+    rload.max_len = cfg.audio.max_len;  // --max-len, else automatic (published or longest train)
     rirs = std::make_unique<data::RirSet>(data::load_rir_set(data_dir, rload));
     if (!old_manifest.is_null() && resume_from && old_manifest.contains("audio"))
       infer::check_audio_manifest(old_manifest["audio"], *rirs, data_dir);
