@@ -4,6 +4,7 @@
 #include "neraf/data/rir_set.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -366,6 +367,29 @@ TEST(FeatureCache, GatherReturnsTheRequestedSlices) {
   EXPECT_THROW(set.gather(torch::tensor({int64_t(set.size())}), torch::tensor({int64_t(0)})),
                c10::Error);
   EXPECT_THROW(set.gather(torch::tensor({int64_t(0)}), torch::tensor({set.max_len})), c10::Error);
+}
+
+// The cache is read, not mapped: a file cut short under a running trainer is one clear error
+// (a mapping would kill the process with SIGBUS), and resident memory does not hold the cache.
+TEST(FeatureCache, ACacheTruncatedWhileInUseIsAClearError) {
+  TempDir dir;
+  SoundSpacesScene scene;
+  scene.write(dir.path());
+  const RirSet set = load_soundspaces(dir.path(), quiet());
+  const torch::Tensor last = set.features(set.size() - 1);
+  ASSERT_EQ(::truncate(set.cache_path.c_str(), fs::file_size(set.cache_path) / 2), 0);
+  EXPECT_TRUE(torch::equal(set.features(0), set.features(0)));  // the first half is still there
+  try {
+    set.features(set.size() - 1);
+    FAIL() << "a read past the truncated end succeeded";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(set.cache_path), std::string::npos) << what;
+    EXPECT_NE(what.find("delete the file"), std::string::npos) << what;
+  }
+  // The next load sees a broken file and rebuilds it.
+  const RirSet again = load_soundspaces(dir.path(), quiet());
+  EXPECT_TRUE(torch::equal(again.features(again.size() - 1), last));
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -3,7 +3,6 @@
 #include <c10/util/Half.h>
 #include <fcntl.h>
 #include <omp.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
@@ -67,6 +66,21 @@ Layout make_layout(const FeatureCacheSpec& s) {
   return l;
 }
 
+// pread until n bytes are in; false (errno set, or 0 at the end of the file) when they cannot be.
+bool read_exactly(int fd, void* data, size_t n, int64_t offset) {
+  char* p = static_cast<char*>(data);
+  errno = 0;
+  while (n > 0) {
+    const ssize_t r = ::pread(fd, p, n, offset);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) return false;
+    p += r;
+    n -= static_cast<size_t>(r);
+    offset += r;
+  }
+  return true;
+}
+
 void pwrite_all(int fd, const void* data, size_t n, int64_t offset, const std::string& path) {
   const char* p = static_cast<const char*>(data);
   while (n > 0) {
@@ -97,27 +111,21 @@ std::shared_ptr<FeatureCache> FeatureCache::open(const std::string& path,
                                                  const FeatureCacheSpec& spec) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return nullptr;
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || st.st_size < 16) {
-    ::close(fd);
-    return nullptr;
-  }
-  const size_t size = static_cast<size_t>(st.st_size);
-  void* map = ::mmap(nullptr, size, PROT_READ, MAP_SHARED, fd, 0);
-  ::close(fd);  // the mapping keeps the file alive
-  if (map == MAP_FAILED) return nullptr;
   std::shared_ptr<FeatureCache> c(new FeatureCache());
-  c->base_ = static_cast<const uint8_t*>(map);
-  c->mapped_bytes_ = size;
+  c->fd_ = fd;  // closed by the destructor, also when the file is refused below
   c->path_ = path;
-  if (std::memcmp(c->base_, kMagic, 8) != 0) return nullptr;
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || st.st_size < 16) return nullptr;
+  const auto size = static_cast<int64_t>(st.st_size);
+  char head[16];
+  if (!read_exactly(fd, head, 16, 0) || std::memcmp(head, kMagic, 8) != 0) return nullptr;
   uint64_t n = 0;
-  std::memcpy(&n, c->base_ + 8, 8);
-  if (n == 0 || 16 + n > size) return nullptr;
-  json h;
+  std::memcpy(&n, head + 8, 8);
+  if (n == 0 || 16 + n > static_cast<uint64_t>(size)) return nullptr;
+  std::string text(n, '\0');
+  if (!read_exactly(fd, text.data(), n, 16)) return nullptr;
   try {
-    h = json::parse(reinterpret_cast<const char*>(c->base_) + 16,
-                    reinterpret_cast<const char*>(c->base_) + 16 + n);
+    const json h = json::parse(text);
     if (h.at("format") != "neraf-features" || h.at("version") != kVersion) return nullptr;
     FeatureCacheSpec s;
     s.key = h.at("key");
@@ -128,8 +136,8 @@ std::shared_ptr<FeatureCache> FeatureCache::open(const std::string& path,
     s.n_freq = h.at("n_freq");
     s.max_len = h.at("max_len");
     s.half = h.at("dtype") == "float16";
-    c->lengths_offset_ = h.at("lengths_offset");
     c->data_offset_ = h.at("data_offset");
+    const int64_t lengths_offset = h.at("lengths_offset");
     if (s.key != spec.key || s.layout != spec.layout || s.half != spec.half) return nullptr;
     for (auto [mine, want] : {std::pair<int64_t, int64_t>{s.n_rirs, spec.n_rirs},
                               {s.channels, spec.channels},
@@ -138,12 +146,16 @@ std::shared_ptr<FeatureCache> FeatureCache::open(const std::string& path,
       if (want != 0 && mine != want) return nullptr;
     const int64_t esize = s.half ? 2 : 4;
     const int64_t need = c->data_offset_ + s.n_rirs * s.max_len * s.channels * s.n_freq * esize;
-    if (c->lengths_offset_ + 4 * s.n_rirs > c->data_offset_ || static_cast<int64_t>(size) != need)
+    if (lengths_offset + 4 * s.n_rirs > c->data_offset_ || size != need) return nullptr;
+    c->lengths_.resize(static_cast<size_t>(s.n_rirs));
+    if (!read_exactly(fd, c->lengths_.data(), c->lengths_.size() * 4, lengths_offset))
       return nullptr;
     c->spec_ = s;
   } catch (const std::exception&) {
     return nullptr;
   }
+  // Training reads scattered frames: no read-ahead of neighbouring pages.
+  ::posix_fadvise(fd, 0, 0, POSIX_FADV_RANDOM);
   return c;
 }
 
@@ -241,24 +253,25 @@ std::shared_ptr<FeatureCache> FeatureCache::build(
 }
 
 FeatureCache::~FeatureCache() {
-  if (base_) ::munmap(const_cast<uint8_t*>(base_), mapped_bytes_);
+  if (fd_ >= 0) ::close(fd_);
 }
 
-int32_t FeatureCache::own_length(int64_t rir) const {
-  int32_t v = 0;
-  std::memcpy(&v, base_ + lengths_offset_ + 4 * rir, 4);
-  return v;
-}
+int32_t FeatureCache::own_length(int64_t rir) const { return lengths_[static_cast<size_t>(rir)]; }
 
 void FeatureCache::read_frames(int64_t rir, int64_t frame, int64_t count, float* out) const {
-  const int64_t slice = slice_size();
-  const int64_t first = (rir * spec_.max_len + frame) * slice;
-  if (!spec_.half) {
-    std::memcpy(out, base_ + data_offset_ + first * 4, static_cast<size_t>(count * slice * 4));
-  } else {
-    const c10::Half* src = reinterpret_cast<const c10::Half*>(base_ + data_offset_) + first;
-    for (int64_t k = 0; k < count * slice; ++k) out[k] = static_cast<float>(src[k]);
-  }
+  const int64_t values = count * slice_size();
+  const int64_t first = (rir * spec_.max_len + frame) * slice_size();
+  auto read = [&](void* to, int64_t esize) {
+    if (!read_exactly(fd_, to, static_cast<size_t>(values * esize), data_offset_ + first * esize))
+      throw Error(path_ + ": cannot read the feature cache (" +
+                  (errno != 0 ? std::string(std::strerror(errno)) : "it was truncated") +
+                  "); delete the file and run the command again to rebuild it");
+  };
+  if (!spec_.half) return read(out, 4);
+  thread_local std::vector<c10::Half> halves;  // grows once; no allocation per training step
+  halves.resize(static_cast<size_t>(values));
+  read(halves.data(), 2);
+  for (int64_t k = 0; k < values; ++k) out[k] = static_cast<float>(halves[k]);
 }
 
 }  // namespace neraf::data

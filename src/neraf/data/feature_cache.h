@@ -1,6 +1,9 @@
 #pragma once
 // The on-disk feature cache of a RirSet: every RIR's padded log-magnitude STFT, written once
-// (atomically, in parallel) and memory-mapped read-only for training.
+// (atomically, in parallel) and read slice by slice with pread for training. It is not
+// memory-mapped: pages of a mapping count in the process's resident memory, so a 25 GB cache
+// would grow the trainer to 25 GB; read, the data stays in the kernel's reclaimable page cache
+// and the process holds only the lengths and one batch.
 //
 // File layout (little-endian):
 //   [0, 8)               magic "NRFFEAT1"
@@ -17,6 +20,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace neraf::data {
 
@@ -56,16 +60,16 @@ class FeatureCache {
   int32_t own_length(int64_t rir) const;
 
   // Copies `count` consecutive frames of RIR `rir` starting at `frame` into out (float32),
-  // [count][channels][n_freq].
+  // [count][channels][n_freq]. Thread-safe; throws neraf::Error when the file cannot be read.
   void read_frames(int64_t rir, int64_t frame, int64_t count, float* out) const;
 
  private:
   FeatureCache() = default;
   FeatureCacheSpec spec_;
   std::string path_;
-  const uint8_t* base_ = nullptr;
-  size_t mapped_bytes_ = 0;
-  int64_t lengths_offset_ = 0, data_offset_ = 0;
+  int fd_ = -1;
+  std::vector<int32_t> lengths_;  // own STFT length of each RIR
+  int64_t data_offset_ = 0;
 };
 
 }  // namespace neraf::data

@@ -184,7 +184,7 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
   // Frames per RIR: the option, RAF's fixed 0.32 s, a published scene's value, else (0 here) the
   // longest training RIR, read from the headers when the cache is built.
   const std::string scene = folder_name(set.root);
-  const std::optional<int64_t> published = ss ? published_max_len(scene) : std::nullopt;
+  const int64_t published = ss ? published_max_len(scene).value_or(0) : 0;  // 0: not published
   int64_t max_len = 0;
   if (options.max_len > 0) {
     max_len = options.max_len;
@@ -192,8 +192,8 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
   } else if (!ss) {
     max_len = detail::kRafMaxLen;
     set.max_len_source = "RAF 0.32 s";
-  } else if (published) {
-    max_len = *published;
+  } else if (published > 0) {
+    max_len = published;
     set.max_len_source = "published (" + scene + ")";
   } else {
     set.max_len_source = "longest training RIR";
@@ -313,11 +313,11 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
     }
   }
   set.max_len = cache->spec().max_len;
-  if (published && options.max_len <= 0) {
+  if (published > 0 && options.max_len <= 0) {
     int64_t longest = 0;
     for (int64_t i : set.train) longest = std::max<int64_t>(longest, cache->own_length(i));
-    if (longest != *published) {
-      set.max_len_note = "max_len " + std::to_string(*published) + " is the published value for " +
+    if (longest != published) {
+      set.max_len_note = "max_len " + std::to_string(published) + " is the published value for " +
                          scene + "; the longest training RIR here has " + std::to_string(longest) +
                          " frames (pass --max-len " + std::to_string(longest) + " to use it)";
       if (options.progress) info(set.root + ": " + set.max_len_note);

@@ -10,8 +10,8 @@
 //
 // Features: per RIR a log-magnitude STFT log(|STFT| + 1e-3), [C, F, max_len]; frames past the
 // RIR's own length are filled with log(min|STFT| + 1e-3) (min over the whole RIR, all channels),
-// longer RIRs are cut at max_len. They are computed once into a cache file and memory-mapped, so a
-// 120k-RIR scene (≈24 GB of features) never has to fit in RAM:
+// longer RIRs are cut at max_len. They are computed once into a cache file and read slice by slice,
+// so a 120k-RIR scene (≈24 GB of features) never has to fit in RAM or in the process's memory:
 //   <scene>/.neraf_cache/<layout>_<16 hex digits>.bin   (or under RirLoadOptions::cache_dir)
 // The hex digits hash the layout, feature parameters and every source file's path, size and
 // modification time: editing, adding or removing a file makes a new cache (the stale one is
@@ -117,7 +117,7 @@ struct RirSet {
   // Log-magnitude STFT of RIR i, padded/cut to max_len. [C, F, max_len] float32
   torch::Tensor features(int64_t i) const;
   // Slices for a training step: out[b] = features(rir[b])[:, :, frame[b]]. rir, frame: [B] int64.
-  // [B, C, F] float32. One contiguous copy per slice from the memory-mapped cache.
+  // [B, C, F] float32. One contiguous read per slice from the cache file.
   torch::Tensor gather(const torch::Tensor& rir, const torch::Tensor& frame) const;
   // Same into a preallocated [B, C, F] float32 contiguous tensor (no allocation per step).
   void gather_into(const torch::Tensor& rir, const torch::Tensor& frame, torch::Tensor& out) const;
@@ -126,7 +126,7 @@ struct RirSet {
   // (zero-padded if shorter). [C, waveform_length] float32
   torch::Tensor waveform(int64_t i) const;
 
-  std::shared_ptr<const FeatureCache> cache_;  // memory-mapped features (shared by copies)
+  std::shared_ptr<const FeatureCache> cache_;  // the cached features (shared by copies)
 };
 
 // SoundSpaces frames per RIR of the scenes the NeRAF paper trains on (office_4 78, room_2 84,
