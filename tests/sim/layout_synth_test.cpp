@@ -17,6 +17,7 @@
 #include "neraf/io/json_file.h"
 #include "neraf/sim/layout_writers.h"
 #include "neraf/sim/microphones.h"
+#include "neraf/sim/plan_drawing.h"
 #include "neraf/sim/scene_json.h"
 #include "neraf/sim/synthesize.h"
 #include "neraf/util/error.h"
@@ -108,6 +109,11 @@ TEST(LayoutSynth, SoundSpacesFilesNamesAndFormats) {
 
   // scene.json: the resolved scene.
   EXPECT_EQ(scene_to_json(load_scene((out / "scene.json").string())), scene_to_json(scene));
+  // plan.png: the top-down plan (plan_drawing.h), the same picture draw_plan gives.
+  {
+    const PlanImage plan = draw_plan(scene, plan_synthesis(scene, "soundspaces", 5));
+    expect_png(out / "plan.png", plan.width, plan.height);
+  }
 
   // Images + transforms.json (eval_mode "filename" names).
   const json t = io::read_json((out / "transforms.json").string());
@@ -255,7 +261,8 @@ TEST(LayoutSynth, SameSeedGivesByteIdenticalFilesAtAnyThreadCount) {
   omp_set_num_threads(saved);
   synthesize(scene, options(c, 12, "soundspaces"));
   const auto ta = tree(a), tb = tree(b), tc = tree(c);
-  EXPECT_EQ(ta.size(), 32u + 6u + 5u);  // RIRs, images, transforms/points/split/scene/synth_info
+  EXPECT_EQ(ta.size(),
+            32u + 6u + 6u);  // RIRs, images, transforms/points/split/scene/synth_info/plan
   ASSERT_EQ(ta.size(), tb.size());
   for (const auto& [name, bytes] : ta) {
     ASSERT_TRUE(tb.count(name)) << name;

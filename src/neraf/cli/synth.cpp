@@ -9,6 +9,8 @@
 #include "neraf/cli/commands.h"
 #include "neraf/cli/flag_checks.h"
 #include "neraf/io/json_file.h"
+#include "neraf/sim/occlusion.h"
+#include "neraf/sim/plan_drawing.h"
 #include "neraf/sim/presets.h"
 #include "neraf/sim/scene_json.h"
 #include "neraf/sim/synthesize.h"
@@ -20,7 +22,8 @@ namespace neraf::cli {
 namespace {
 
 struct SynthArgs {
-  std::string scene_file, preset, layout = "soundspaces", out_dir, hrtf, mics, gain_from;
+  // layout "": the preset's (sim::preset_layout), soundspaces for a scene file.
+  std::string scene_file, preset, layout, out_dir, hrtf, mics, gain_from, plan_only;
   int64_t mic_count = 0;
   uint64_t seed = 0;
   int threads = 0;
@@ -33,7 +36,7 @@ std::string preset_list() {
   return s;
 }
 
-void run_synth(const SynthArgs& a) {
+void run_synth(SynthArgs a) {
   require(a.scene_file.empty() != a.preset.empty(),
           "synth: give exactly one of --scene FILE.json or --preset NAME (" + preset_list() + ")");
   sim::Scene scene = a.preset.empty() ? sim::load_scene(a.scene_file) : sim::preset_scene(a.preset);
@@ -42,6 +45,7 @@ void run_synth(const SynthArgs& a) {
           "--mic-count: only used with random microphones; add --mics random");
   if (a.mic_count > 0) scene.microphones.random.count = a.mic_count;
   const std::string where = a.preset.empty() ? a.scene_file : "preset " + a.preset;
+  if (a.layout.empty()) a.layout = a.preset.empty() ? "soundspaces" : sim::preset_layout(a.preset);
   if (!a.preset.empty() || !a.mics.empty() || a.mic_count > 0) sim::validate_scene(scene, where);
   if (a.print_scene) {
     std::printf("%s\n", sim::scene_to_json(scene).dump(2).c_str());
@@ -49,6 +53,13 @@ void run_synth(const SynthArgs& a) {
   }
   // Before the plan (a million microphones would already be gigabytes of jobs) and before --out.
   sim::check_synthesis_size(scene, a.layout, where, "--mics, --mic-count");
+  if (!a.plan_only.empty()) {
+    const sim::SynthPlan plan = sim::plan_synthesis(scene, a.layout, a.seed);
+    sim::write_plan_png(a.plan_only, sim::draw_plan(scene, plan));
+    std::printf("wrote the plan of scene \"%s\" (%s layout, %zu RIRs) to %s\n", scene.name.c_str(),
+                plan.layout.c_str(), plan.jobs.size(), a.plan_only.c_str());
+    return;
+  }
   if (a.dry_run) {
     const sim::SynthPlan plan = sim::plan_synthesis(scene, a.layout, a.seed);
     std::printf(
@@ -59,6 +70,12 @@ void run_synth(const SynthArgs& a) {
         plan.binaural ? 2 : 1, plan.sample_rate, scene.acoustics.rir_length_s,
         plan.train_cameras.size(), plan.eval_cameras.size(), scene.cameras.width,
         scene.cameras.height);
+    if (!scene.furniture.empty()) {
+      const sim::DirectPathCount d = sim::count_blocked_direct_paths(scene, plan);
+      std::printf(
+          "direct path blocked by a box for %lld of %lld source-microphone pairs (%.1f %%)\n",
+          static_cast<long long>(d.blocked), static_cast<long long>(d.pairs), 100.0 * d.share());
+    }
     return;
   }
   require(!a.out_dir.empty(), "synth: --out DIR is required (the dataset folder to create)");
@@ -115,14 +132,17 @@ void register_synth(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_option(
       "--preset", args->preset,
-      "Built-in scene instead of --scene: demo (small furnished room, trains in minutes), "
-      "shoebox (empty room), furnished (larger room, more data)");
+      "Built-in scene instead of --scene (docs/SCENE_FORMAT.md): demo (small furnished room, "
+      "trains in minutes), shoebox (empty room), furnished (larger room, more data), occluded "
+      "(a partition with a doorway blocks the direct path), furnished_room / empty_room (one "
+      "RAF-like room with and without furniture), small_dead / large_live (size and "
+      "absorption), apartment (5 rooms, >= 20,000 binaural RIRs), raf_large (20,000 mono RIRs)");
   cmd->add_option("--layout", args->layout,
                   "Output layout: soundspaces (binaural 44.1 kHz RIRs, 4 headings, "
                   "train_/eval_ images) or raf (mono 48 kHz RIRs, directional sources, "
-                  "frame_ images split 90/10 by the reader)")
-      ->check(CLI::IsMember({"soundspaces", "raf"}))
-      ->capture_default_str();
+                  "frame_ images split 90/10 by the reader). Default: raf for the presets "
+                  "furnished_room, empty_room and raf_large, soundspaces otherwise")
+      ->check(CLI::IsMember({"soundspaces", "raf"}));
   cmd->add_option("--mics", args->mics,
                   "Microphone placement instead of the scene's: grid (SoundSpaces-like regular "
                   "grid) or random (the scene's microphones.random settings). The same room "
@@ -157,10 +177,21 @@ void register_synth(CLI::App& app) {
   cmd->add_flag("--print-scene", args->print_scene,
                 "Print the resolved scene JSON (e.g. of a preset, to edit and pass back with "
                 "--scene) and exit");
-  cmd->add_flag("--dry-run", args->dry_run,
-                "Print how many RIRs and images the scene gives in this layout and exit (writes "
-                "nothing)");
-  cmd->callback([args] { run_synth(*args); });
+  CLI::Option* plan_only = cmd->add_option(
+      "--plan-only", args->plan_only,
+      "Draw the top-down plan of the scene (walls, furniture, microphones, sources, cameras; as "
+      "the dataset's plan.png) into this PNG file and exit without synthesising");
+  CLI::Option* dry_run = cmd->add_flag(
+      "--dry-run", args->dry_run,
+      "Print how many RIRs and images the scene gives in this layout and exit (writes "
+      "nothing)");
+  plan_only->excludes(dry_run);
+  cmd->callback([args] {
+    require(args->plan_only.empty() || args->out_dir.empty(),
+            "--plan-only: draws the plan without synthesising; drop --out (a synthesised "
+            "dataset gets its plan as DIR/plan.png)");
+    run_synth(*args);
+  });
 }
 
 }  // namespace neraf::cli

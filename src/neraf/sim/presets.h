@@ -17,5 +17,9 @@ namespace neraf::sim {
 std::vector<std::string> preset_names();
 // Throws neraf::Error naming the known presets for an unknown name.
 Scene preset_scene(const std::string& name);
+// The layout `neraf synth --preset NAME` writes unless --layout is given: "raf" for the RAF-like
+// presets (random omni microphones, directional sources), "soundspaces" for the others. A scene
+// JSON (--scene, --print-scene) carries no layout: give --layout raf with it.
+std::string preset_layout(const std::string& name);
 
 }  // namespace neraf::sim

@@ -20,6 +20,7 @@
 #include "neraf/sim/image_renderer.h"
 #include "neraf/sim/layout_writers.h"
 #include "neraf/sim/microphones.h"
+#include "neraf/sim/plan_drawing.h"
 #include "neraf/sim/rir_simulator.h"
 #include "neraf/sim/scene_json.h"
 #include "neraf/sim/seeded_random.h"
@@ -238,6 +239,7 @@ SynthSummary write_dataset(const Scene& scene, const SynthOptions& options, cons
     io::write_json_atomically(out("metadata/data-split.json"), split);
   }
   io::write_json_atomically(out("scene.json"), scene_to_json(scene));
+  write_plan_png(out("plan.png"), draw_plan(scene, plan));
 
   const auto t60 = simulator.eyring_t60();
   json info = {{"generator", "neraf synth"},

@@ -3,7 +3,8 @@
 // the files of the chosen layout (layout_writers), in one output folder:
 //
 //   soundspaces (NeRAF's SoundSpaces layout, binaural 44.1 kHz)   raf (RAF layout, mono 48 kHz)
-//     scene.json, synth_info.json                                  scene.json, synth_info.json
+//     scene.json, synth_info.json, plan.png                        scene.json, synth_info.json,
+//                                                                  plan.png
 //     transforms.json + images/{train,eval}_frame_XXXXX.png        transforms.json +
 //     images/frame_XXXXX.png metadata/points.txt data/<6-digit id>/rir.wav
 //     metadata_AudioNeRF/split.json                                data/<id>/rx_pos.txt, tx_pos.txt
