@@ -90,13 +90,23 @@ TEST(AcousticModel, RelativeGeometryIsAppendedAfterTheReferenceInputs) {
   torch::manual_seed(4);
   auto o = small_options(GridMode::kNone);
   o.nacf.relative_geometry = true;
-  o.nacf.extent_m = {4, 2, 3};
+  o.nacf.box_min = {-1, 0, 1};
+  o.nacf.box_max = {3, 2, 4};
   o.nacf.position_max_freq_exp = 1.0;
   AcousticModel m(o);
   EXPECT_EQ(m->field()->options().in_features(), 163 + kRelativeGeometryDim);
-  const auto b = random_batch(4, 12);
+  // Positions in metres, some outside the box: the position encodings take the normalised
+  // positions (zero outside), the relative geometry the metres.
+  Batch b = random_batch(4, 12);
+  b.mic = b.mic * 6 - 2;
+  b.src = b.src * 6 - 2;
   const auto y = m->forward(torch::Tensor(), b.t, b.mic, b.src, b.rot);
-  const auto h = torch::cat({nacf_input(torch::Tensor(), b.t, 12, b.mic, b.src, b.rot, 1.0),
+  const auto mn = normalize_to_box(b.mic, o.nacf.box_min, o.nacf.box_max);
+  const auto sn = normalize_to_box(b.src, o.nacf.box_min, o.nacf.box_max);
+  EXPECT_GT(
+      (sn.abs().sum(1) == 0).sum().item<int64_t>() + (mn.abs().sum(1) == 0).sum().item<int64_t>(),
+      0);
+  const auto h = torch::cat({nacf_input(torch::Tensor(), b.t, 12, mn, sn, b.rot, 1.0),
                              encode_relative_geometry(b.mic, b.src, b.rot, {4, 2, 3})},
                             1);
   EXPECT_TRUE(torch::allclose(y, m->field()->forward(h)));

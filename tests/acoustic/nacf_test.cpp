@@ -46,8 +46,8 @@ torch::Tensor stored_rot(double deg) {
 
 TEST(Nacf, RelativeGeometryHandComputed) {
   // Audio box 4 × 2 × 4 m; source 1 m along +x from the mic, listener heading 90°.
-  const auto mic = torch::tensor({{0.5, 0.5, 0.5}}, torch::kFloat64);
-  const auto src = torch::tensor({{0.75, 0.5, 0.5}}, torch::kFloat64);
+  const auto mic = torch::tensor({{2.0, 1.0, 2.0}}, torch::kFloat64);
+  const auto src = torch::tensor({{3.0, 1.0, 2.0}}, torch::kFloat64);
   const auto g = encode_relative_geometry(mic, src, stored_rot(90), {4, 2, 4});
   ASSERT_EQ(g.sizes(), (std::vector<int64_t>{1, kRelativeGeometryDim}));
   EXPECT_EQ(g.dtype(), torch::kFloat32);
@@ -64,7 +64,7 @@ TEST(Nacf, RelativeGeometryHandComputed) {
     EXPECT_NEAR(g[0][17 + 2 * k].item<double>(), std::cos(2 * M_PI * (1 << k) * rel), 1e-6);
   }
   // Straight above: elevation 1; the distance is clamped to 5 cm when the two coincide.
-  const auto up = encode_relative_geometry(mic, torch::tensor({{0.5, 1.0, 0.5}}, torch::kFloat64),
+  const auto up = encode_relative_geometry(mic, torch::tensor({{2.0, 2.0, 2.0}}, torch::kFloat64),
                                            stored_rot(0), {4, 2, 4});
   EXPECT_NEAR(up[0][12].item<double>(), 1.0, 1e-6);
   const auto same = encode_relative_geometry(mic, mic, stored_rot(0), {4, 2, 4});
@@ -75,11 +75,11 @@ TEST(Nacf, RelativeGeometryFollowsTheListenerNotTheRoom) {
   // Turning the source direction and the heading by the same angle about y leaves the
   // heading-relative features (φ − θ) and the distance features unchanged.
   const std::array<double, 3> extent{4, 2, 4};
-  const auto mic = torch::tensor({{0.5, 0.4, 0.5}}, torch::kFloat64);
+  const auto mic = torch::tensor({{2.0, 0.8, 2.0}}, torch::kFloat64);
   auto source_at = [&](double deg) {
     const double a = deg * M_PI / 180.0;  // 1.2 m away at azimuth 30° + deg, 0.2 m higher
     return torch::tensor(
-        {{0.5 + 1.2 * std::cos(a + M_PI / 6) / 4, 0.5, 0.5 + 1.2 * std::sin(a + M_PI / 6) / 4}},
+        {{2.0 + 1.2 * std::cos(a + M_PI / 6), 1.0, 2.0 + 1.2 * std::sin(a + M_PI / 6)}},
         torch::kFloat64);
   };
   const auto a = encode_relative_geometry(mic, source_at(0), stored_rot(10), extent);
@@ -90,6 +90,37 @@ TEST(Nacf, RelativeGeometryFollowsTheListenerNotTheRoom) {
         EXPECT_NEAR(a[0][4 * k + j].item<double>(), b[0][4 * k + j].item<double>(), 1e-5);
     EXPECT_TRUE(torch::allclose(a.slice(1, 12), b.slice(1, 12), 1e-5, 1e-6));
   }
+}
+
+// A source outside the audio box (RAF loudspeakers often are: the box is the train mics ± 1 m):
+// its position encoding is the reference's zero vector, but the relative geometry is computed from
+// the metres, so its direction and distance are right.
+TEST(Nacf, SourceOutsideTheBoxKeepsItsDirectionAndDistance) {
+  NacfOptions o = nacf_cpu_options(1, 9, 0);
+  o.relative_geometry = true;
+  o.box_min = {-1.0, 0.0, -2.0};
+  o.box_max = {3.0, 2.5, 1.5};  // extent 4 × 2.5 × 3.5 m
+  const auto t = torch::tensor({0}, torch::kInt64);
+  const auto mic = torch::tensor({{1.0, 1.0, 0.0}}, torch::kFloat64);  // inside
+  const auto src = torch::tensor({{1.0, 1.0, 5.0}}, torch::kFloat64);  // 5 m along +z: outside
+  const auto h = nacf_input(o, torch::Tensor(), t, 12, mic, src, stored_rot(0));
+  ASSERT_EQ(h.sizes(), (std::vector<int64_t>{1, 163 + kRelativeGeometryDim}));
+  // No-grid order [mic 63, src 63, time 21, rot 16, relative 22]: the source encodes as zeros.
+  const auto zeros = torch::zeros({1, 3}, torch::kFloat64);
+  EXPECT_TRUE(torch::equal(h.slice(1, 63, 126), encode_position(zeros, o.position_max_freq_exp)));
+  EXPECT_TRUE(torch::equal(
+      h.slice(1, 0, 63),
+      encode_position(normalize_to_box(mic, o.box_min, o.box_max), o.position_max_freq_exp)));
+  const auto g = h.slice(1, 163);
+  // Heading 0, source at azimuth atan2(dz, dx) = 90°: cos, sin of k·90° for both senses.
+  const double expected_angles[] = {0, 1, 0, 1, -1, 0, -1, 0, 0, -1, 0, -1};
+  for (int i = 0; i < 12; ++i) EXPECT_NEAR(g[0][i].item<double>(), expected_angles[i], 1e-6) << i;
+  EXPECT_NEAR(g[0][12].item<double>(), 0.0, 1e-6);                    // level
+  EXPECT_NEAR(g[0][14].item<double>(), 5.0 / std::sqrt(34.5), 1e-6);  // 5 m / box diagonal
+  EXPECT_NEAR(g[0][15].item<double>(), std::log(5.0), 1e-6);          // ln 5 m
+  // From the normalised positions the source would sit at the zero vector, i.e. at the box's
+  // minimum corner, 3 m from the mic in another direction.
+  EXPECT_GT(std::abs(g[0][15].item<double>() - std::log(3.0)), 0.4);
 }
 
 TEST(Nacf, ShapesAndTanhRange) {

@@ -116,6 +116,36 @@ TEST(ResNet3d, EvalEqualsTrainModeOnTheSameGrid) {
   EXPECT_TRUE(torch::allclose(train_out, scaled, 1e-3, 1e-3));
 }
 
+// The reference's BatchNorm (preset reference): train-mode forwards update running statistics
+// (momentum 0.1, PyTorch's unbiased running variance), which eval mode then uses instead of the
+// grid's own: the eval feature differs from the train one, and matches a BatchNorm that is given
+// the same running statistics explicitly.
+TEST(ResNet3d, ReferenceBatchNormUsesRunningStatisticsInEvalMode) {
+  torch::manual_seed(4);
+  ResNet3dOptions o = resnet3d_cpu_options();
+  o.running_stats = true;
+  ResNet3d net(o);
+  int64_t running = 0;
+  for (const auto& b : net->named_buffers())
+    running += b.key().find("running_mean") != std::string::npos;
+  EXPECT_EQ(running, 10);  // the stem's, then 2 + a downsample's per BasicBlock, 3 blocks
+  const auto x = torch::rand({1, 7, 32, 32, 32});
+  const auto train_out = net->forward(x);
+  const auto stem = net->named_modules()["bn1"]->as<torch::nn::BatchNorm3d>();
+  ASSERT_NE(stem, nullptr);
+  EXPECT_EQ(stem->num_batches_tracked.item<int64_t>(), 1);
+  EXPECT_FALSE(torch::allclose(stem->running_mean, torch::zeros_like(stem->running_mean)));
+  net->eval();
+  const auto eval_out = net->forward(x);
+  EXPECT_FALSE(torch::allclose(train_out, eval_out, 1e-3, 1e-3));
+  EXPECT_TRUE(torch::equal(eval_out, net->forward(x)));  // eval mode updates nothing
+  EXPECT_EQ(stem->num_batches_tracked.item<int64_t>(), 1);
+  // The default has no running statistics at all.
+  ResNet3d ours(resnet3d_cpu_options());
+  for (const auto& b : ours->named_buffers())
+    EXPECT_EQ(b.key().find("running"), std::string::npos) << b.key();
+}
+
 TEST(ResNet3d, RejectsBadInput) {
   ResNet3d net(resnet3d_cpu_options());
   EXPECT_THROW(net->forward(torch::rand({1, 6, 32, 32, 32})), std::exception);

@@ -9,6 +9,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 
 #include "audio_test_util.h"
@@ -44,7 +45,7 @@ std::string make_run(const std::string& dir, const data::RirSet& rirs, const Tra
   return run_dir;
 }
 
-// The dataset's poses plus poses spread over the box: [N, 3], [N, 3], [N].
+// The dataset's poses plus two with the source outside the box: [N, 3], [N, 3], [N].
 struct Poses {
   torch::Tensor mic, src, yaw;
 };
@@ -55,18 +56,32 @@ Poses poses_of(const data::RirSet& rirs) {
     s.insert(s.end(), {r.source.x, r.source.y, r.source.z});
     y.push_back(r.heading_deg + 17.0);  // off the trained headings too
   }
+  // Sources outside the audio box (as RAF loudspeakers often are): zero position encoding, true
+  // relative geometry, in both paths alike.
+  const data::Aabb& box = rirs.audio_aabb;
+  const data::Rir& first = rirs.rirs.front();
+  for (const geometry::Vec3& outside :
+       {geometry::Vec3{box.max.x + 2.0, first.source.y, first.source.z},
+        geometry::Vec3{box.min.x - 1.5, box.min.y + 0.5, box.max.z + 3.0}}) {
+    m.insert(m.end(), {first.mic.x, first.mic.y, first.mic.z});
+    s.insert(s.end(), {outside.x, outside.y, outside.z});
+    y.push_back(33.0);
+  }
   const int64_t n = static_cast<int64_t>(y.size());
   return {torch::tensor(m, torch::kFloat64).view({n, 3}),
           torch::tensor(s, torch::kFloat64).view({n, 3}), torch::tensor(y, torch::kFloat64)};
 }
 
-void expect_same_predictions(const std::string& grid) {
-  const std::string dir = make_temp_dir("export_" + grid);
+// `check` inspects the loaded run first.
+void expect_same_predictions(const std::string& grid, TrainConfig c = tiny_joint_config(),
+                             const std::string& tag = "",
+                             const std::function<void(const AudioRun&)>& check = {}) {
+  const std::string dir = make_temp_dir("export_" + grid + tag);
   const data::RirSet rirs = tiny_rir_set(dir);
-  TrainConfig c = tiny_joint_config();
   c.audio.grid = grid;
   const AudioRun run = load_audio_run(make_run(dir, rirs, c));
-  ASSERT_TRUE(run.calibration().defined());
+  ASSERT_EQ(run.calibration().defined(), c.audio.energy_calibration);
+  if (check) check(run);
 
   const std::string path = dir + "/model.nrf";
   const ExportReport report = export_model(run, path);
@@ -106,6 +121,60 @@ TEST(ExportedModel, SampledGridFoldedIntoTheBiasMatchesLibTorch) {
 }
 
 TEST(ExportedModel, NoGridMatchesLibTorch) { expect_same_predictions("none"); }
+
+// The tiny run with preset reference's own options (its ResNet3D-50 and NAcF input, its 18
+// viewing directions, BatchNorm with running statistics, no calibration, no relative geometry):
+// it trains, its checkpoint holds the running statistics two train-mode steps left, and the export
+// folds the eval-mode scene feature (running statistics) so that the runtime matches LibTorch.
+TEST(ExportedModel, ReferencePresetTrainsAndExports) {
+  TrainConfig c = tiny_joint_config();
+  const TrainConfig ref = train_preset("reference");
+  c.preset = "reference";
+  c.audio.view_directions = ref.audio.view_directions;
+  c.audio.resnet_batch_norm = ref.audio.resnet_batch_norm;
+  c.audio.energy_calibration = ref.audio.energy_calibration;
+  c.audio.relative_geometry = ref.audio.relative_geometry;
+  c.audio.position_max_freq_exp = ref.audio.position_max_freq_exp;
+  c.audio.early_fraction = ref.audio.early_fraction;
+  expect_same_predictions("sampled", c, "_reference", [](const AudioRun& run) {
+    const acoustic::AcousticModelOptions& o = run.model()->options();
+    EXPECT_EQ(o.grid.view_directions, acoustic::ViewDirections::kReference);
+    EXPECT_TRUE(o.resnet.running_stats);
+    EXPECT_EQ(o.resnet.block, acoustic::ResBlock::kBottleneck);  // ResNet3D-50
+    EXPECT_EQ(o.nacf.in_features(), 1024 + 163);
+    const auto buffers = run.model()->named_buffers();
+    const torch::Tensor* tracked = buffers.find("resnet3d.bn1.num_batches_tracked");
+    ASSERT_NE(tracked, nullptr);
+    EXPECT_EQ(tracked->item<int64_t>(), 2);  // one train-mode ResNet3D pass per audio step
+  });
+}
+
+// A run trained with a bf16 trunk is evaluated in fp32 by default: exactly the numbers of the same
+// checkpoint in a run that trained in fp32 (its config.json says fp32; the weights are the same
+// fp32 master weights), and not those of --precision bf16.
+TEST(AudioRunPrecision, Bf16TrainedRunEvaluatesInFp32ByDefault) {
+  const std::string dir = make_temp_dir("precision_bf16");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  TrainConfig c = tiny_joint_config();
+  c.model.precision = nerf::Precision::bf16;
+  const std::string run_dir = make_run(dir, rirs, c);
+  const std::string as_fp32 = dir + "/as_fp32";
+  std::filesystem::copy(run_dir, as_fp32, std::filesystem::copy_options::recursive);
+  TrainConfig f = c;
+  f.model.precision = nerf::Precision::fp32;
+  io::write_json_atomically(as_fp32 + "/config.json", to_json(f));
+
+  const AudioRun trained_bf16 = load_audio_run(run_dir);
+  EXPECT_FALSE(trained_bf16.model()->options().nacf.bf16);
+  const AudioRun trained_fp32 = load_audio_run(as_fp32);
+  const AudioRun asked_bf16 = load_audio_run(run_dir, torch::kCPU, "", nerf::Precision::bf16);
+  const Poses p = poses_of(rirs);
+  const torch::Tensor a = trained_bf16.predict_log_stft_batch(p.mic, p.src, p.yaw);
+  EXPECT_TRUE(torch::equal(a, trained_fp32.predict_log_stft_batch(p.mic, p.src, p.yaw)));
+  EXPECT_FALSE(torch::equal(a, asked_bf16.predict_log_stft_batch(p.mic, p.src, p.yaw)));
+  // The fp32 export of either is the same field.
+  EXPECT_LT(export_model(trained_bf16, dir + "/bf16_trained.nrf").max_abs_difference, 1e-4);
+}
 
 // Queries are fp32 by default whatever trained the run (the tiny config trains in fp32 here);
 // bf16 on request rounds the trunk's products: close to, not equal to, fp32.

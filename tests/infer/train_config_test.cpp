@@ -6,6 +6,9 @@
 
 #include <filesystem>
 
+#include "neraf/acoustic/acoustic_model.h"
+#include "neraf/data/rir_set.h"
+#include "neraf/infer/audio_run.h"
 #include "neraf/util/error.h"
 
 namespace neraf::infer {
@@ -18,14 +21,14 @@ TrainConfig resolve(const std::string& preset, Modality modality, TrainFlags fla
 }
 
 TEST(TrainConfig, JsonRoundTrip) {
-  for (const char* name : {"cpu", "paper"}) {
+  for (const char* name : {"cpu", "paper", "reference"}) {
     TrainConfig c = train_preset(name);
     c.seed = 1234;
     const auto j = to_json(c);
     const TrainConfig back = train_config_from_json(j, "test");
     EXPECT_EQ(to_json(back), j);
     EXPECT_EQ(j["model"]["field"]["grid"]["log2_hashmap_size"],
-              std::string(name) == "paper" ? 19 : 17);
+              std::string(name) == "cpu" ? 17 : 19);
   }
   EXPECT_THROW(train_config_from_json(nlohmann::json::parse(R"({"preset": "gpu"})"), "x"),
                neraf::Error);
@@ -171,6 +174,72 @@ TEST(ResolveTrainConfig, VisionRunOnlyWithAudioAndAbsolute) {
   EXPECT_EQ(c.audio.vision_run,
             (std::filesystem::current_path() / "runs" / "vision").lexically_normal().string());
   EXPECT_TRUE(resolve("cpu", Modality::audio).audio.vision_run.empty());
+}
+
+// `reference` is the published model exactly: paper's sizes and schedule, no calibration, no
+// relative geometry, the reference position encoding, its 18 viewing directions and its BatchNorm;
+// the options are in config.json and reach the model a run builds.
+TEST(TrainConfig, ReferencePresetIsThePublishedModel) {
+  const TrainConfig paper = train_preset("paper");
+  const TrainConfig ref = train_preset("reference");
+  EXPECT_EQ(ref.preset, "reference");
+  EXPECT_FALSE(ref.audio.energy_calibration);
+  EXPECT_FALSE(ref.audio.relative_geometry);
+  EXPECT_EQ(ref.audio.position_max_freq_exp, 8.0);
+  EXPECT_EQ(ref.audio.view_directions, "reference");
+  EXPECT_EQ(ref.audio.resnet_batch_norm, "running");
+  EXPECT_EQ(ref.audio.early_fraction, 0.0);
+  EXPECT_EQ(ref.audio.decay_weight, 0.0);
+  // paper and cpu keep ours.
+  for (const TrainConfig& x : {paper, train_preset("cpu")}) {
+    EXPECT_EQ(x.audio.view_directions, "spread");
+    EXPECT_EQ(x.audio.resnet_batch_norm, "grid");
+  }
+  // Apart from those two, reference is paper, flag for flag (the radiance field included).
+  nlohmann::json a = to_json(ref), b = to_json(paper);
+  for (nlohmann::json* j : {&a, &b}) {
+    j->erase("preset");
+    (*j)["audio"].erase("view_directions");
+    (*j)["audio"].erase("resnet_batch_norm");
+  }
+  EXPECT_EQ(a, b);
+  const TrainConfig joint = resolve("reference", Modality::joint);
+  EXPECT_EQ(joint.steps, 400001);
+  EXPECT_EQ(joint.audio.start_step, 2000);
+  EXPECT_EQ(joint.audio.schedule.max_steps, 1002000);
+  EXPECT_EQ(resolve("reference", Modality::audio).steps, 398000);
+  // Recorded in config.json, read back as written.
+  nlohmann::json j = to_json(joint);
+  EXPECT_EQ(j["audio"]["view_directions"], "reference");
+  EXPECT_EQ(j["audio"]["resnet_batch_norm"], "running");
+  EXPECT_EQ(to_json(train_config_from_json(j, "config.json")), j);
+  // A config.json older than the options (no keys) takes its preset's: ours for cpu and paper.
+  nlohmann::json old = to_json(resolve("paper", Modality::joint));
+  old["audio"].erase("view_directions");
+  old["audio"].erase("resnet_batch_norm");
+  EXPECT_EQ(train_config_from_json(old, "config.json").audio.view_directions, "spread");
+  // The model a run builds honours them.
+  data::Aabb box{{-1, 0, -1}, {3, 2, 3}};
+  const acoustic::AcousticModelOptions o = audio_model_options(joint, 1, 513, 60, box);
+  EXPECT_EQ(o.grid.view_directions, acoustic::ViewDirections::kReference);
+  EXPECT_TRUE(o.resnet.running_stats);
+  EXPECT_FALSE(o.nacf.relative_geometry);
+  EXPECT_EQ(o.nacf.position_max_freq_exp, 8.0);
+  EXPECT_EQ(o.nacf.in_features(), 1187);
+  EXPECT_EQ(o.nacf.trunk, (std::vector<int64_t>{5096, 2048, 1024, 1024, 512}));
+  EXPECT_EQ(o.grid.resolution, 128);
+  const acoustic::AcousticModelOptions p =
+      audio_model_options(resolve("paper", Modality::joint), 1, 513, 60, box);
+  EXPECT_EQ(p.grid.view_directions, acoustic::ViewDirections::kSpread);
+  EXPECT_FALSE(p.resnet.running_stats);
+  // A hand-edited value is refused, naming the key.
+  TrainConfig bad = joint;
+  bad.audio.resnet_batch_norm = "batch";
+  EXPECT_THROW(validate(bad, "config.json"), Error);
+  bad = joint;
+  bad.audio.view_directions = "fibonacci";
+  EXPECT_THROW(validate(bad, "config.json"), Error);
+  EXPECT_NO_THROW(validate(joint, "config.json"));
 }
 
 TEST(ResolveTrainConfig, UnknownPresetIsAnError) {

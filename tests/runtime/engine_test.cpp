@@ -1,6 +1,8 @@
 // The runtime's log-STFT against a slow, straightforward reference written here from the
 // definitions (src/neraf/acoustic/nacf.h): the canonical input of every frame built in full, every
 // layer as plain loops in double, no folding, no time table, libm's tanh/exp/log.
+#include "neraf/runtime/engine.h"
+
 #include <dlfcn.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -12,7 +14,6 @@
 #include <vector>
 
 #include "neraf/neraf_rt.h"
-#include "neraf/runtime/engine.h"
 #include "random_model.h"
 
 namespace fs = std::filesystem;
@@ -90,8 +91,8 @@ std::vector<double> reference_log_stft(const ModelData& m, const neraf_pose& pos
   const std::vector<double> r = sh4(rot[0] * 2 - 1, rot[1] * 2 - 1, rot[2] * 2 - 1);
   pose_in.insert(pose_in.end(), r.begin(), r.end());
   if (m.relative_geometry) {
-    double d[3];
-    for (int k = 0; k < 3; ++k) d[k] = (src[k] - mic[k]) * m.extent_m[k];
+    double d[3];  // from the metres, not the normalised positions (zero outside the box)
+    for (int k = 0; k < 3; ++k) d[k] = pose.source[k] - pose.mic[k];
     const double dist = std::max(std::hypot(d[0], d[1], d[2]), 0.05);
     const double heading = std::atan2(2 * rot[2] - 1, 2 * rot[0] - 1);
     const double azimuth = std::atan2(d[2], d[0]);
@@ -178,8 +179,7 @@ class LoadedModel {
 
 std::vector<neraf_pose> test_poses() {
   return {
-      {{0.5, 1.2, -0.5}, {2.0, 1.5, 1.0}, 0.0},
-      {{2.9, 0.1, 1.4}, {-0.9, 2.4, -1.9}, 90.0},
+      {{0.5, 1.2, -0.5}, {2.0, 1.5, 1.0}, 0.0},   {{2.9, 0.1, 1.4}, {-0.9, 2.4, -1.9}, 90.0},
       {{1.0, 1.0, 0.0}, {1.01, 1.0, 0.0}, -37.5},  // source 1 cm away: the 5 cm distance clamp
       {{-1.0, 1.0, 0.0}, {0.0, 2.0, 1.0}, 400.0},  // mic on the box's face: normalised to zeros
       {{0.3, 2.2, 0.7}, {0.3, 0.2, 0.7}, 180.0},   // source straight below
@@ -203,8 +203,12 @@ void expect_matches_reference(const RandomModelOptions& o, unsigned flags = NERA
   neraf_workspace* ws = nullptr;
   ASSERT_EQ(neraf_workspace_create(model.get(), &ws), NERAF_OK);
   std::vector<float> out(size_t(m.channels) * m.n_freq * m.max_len);
-  for (const neraf_pose& pose : test_poses()) {
-    ASSERT_EQ(neraf_query_log_stft(model.get(), ws, &pose, 0, out.data(), out.size()), NERAF_OK)
+  std::vector<neraf_pose> poses = test_poses();
+  poses.push_back({{1.0, 1.0, 0.0}, {6.0, 1.5, -3.0}, 45.0});  // source outside (RAF loudspeaker)
+  for (const neraf_pose& pose : poses) {
+    ASSERT_EQ(
+        neraf_query_log_stft(model.get(), ws, &pose, NERAF_ALLOW_OUTSIDE, out.data(), out.size()),
+        NERAF_OK)
         << neraf_last_error();
     EXPECT_LT(max_abs_diff(out, reference_log_stft(m, pose, bf16_activations)), tolerance)
         << "pose yaw " << pose.yaw_deg << " relative_geometry " << o.relative_geometry;
@@ -259,7 +263,7 @@ TEST(Engine, Bfloat16TrunkOnAmx) {
     if (std::string(neraf_model_compute(probe.get())) != "bfloat16-amx")
       GTEST_SKIP() << "no AMX-BF16 here: " << neraf_model_compute(probe.get());
   }
-  expect_matches_reference(o, 0, /*bf16_activations=*/true, 1e-4);  // measured 1.4e-6
+  expect_matches_reference(o, 0, /*bf16_activations=*/true, 1e-4);   // measured 1.4e-6
   expect_matches_reference(o, 0, /*bf16_activations=*/false, 0.05);  // measured 7.7e-3
 }
 
@@ -282,6 +286,29 @@ TEST(Engine, OutsideTheBoxEncodesAsTheTrainingCodeDoes) {
   ASSERT_EQ(neraf_query_log_stft(model.get(), ws, &p2, NERAF_ALLOW_OUTSIDE, b.data(), n), NERAF_OK);
   EXPECT_EQ(a, b);
   neraf_workspace_free(ws);
+}
+
+// A source outside the box: its position encoding is the zero vector's (the reference's rule),
+// its relative geometry the true direction and distance, from the metres.
+TEST(Engine, SourceOutsideTheBoxKeepsItsDirectionAndDistance) {
+  RandomModelOptions o;
+  o.relative_geometry = true;
+  const ModelData m = random_model(o);  // box [-1, 3] × [0, 2.5] × [-2, 1.5]
+  const neraf::rt::Engine engine(m);
+  ASSERT_EQ(engine.pose_dim(), 2 * 63 + 16 + 22);
+  const neraf_pose pose = {{1.0, 1.0, 0.0}, {1.0, 1.0, 5.0}, 0.0};  // source 5 m along +z
+  std::vector<float> enc(size_t(engine.pose_dim()));
+  engine.encode_pose(pose, enc.data());
+  for (int i = 0; i < 63; ++i)  // [sin (30), cos (30), raw (3)] of the zero vector
+    EXPECT_EQ(enc[63 + i], i >= 30 && i < 60 ? 1.0f : 0.0f) << i;
+  const float* g = enc.data() + 2 * 63 + 16;
+  // Heading 0, azimuth atan2(dz, dx) = 90°: cos, sin of k·90° for both senses, k = 1..3.
+  const float expected_angles[] = {0, 1, 0, 1, -1, 0, -1, 0, 0, -1, 0, -1};
+  for (int i = 0; i < 12; ++i) EXPECT_NEAR(g[i], expected_angles[i], 1e-6) << i;
+  EXPECT_NEAR(g[12], 0.0, 1e-6);  // level with the listener
+  EXPECT_NEAR(g[13], 1.0, 1e-6);
+  EXPECT_NEAR(g[14], 5.0 / std::sqrt(34.5), 1e-6);  // 5 m over the box diagonal
+  EXPECT_NEAR(g[15], std::log(5.0), 1e-6);
 }
 
 TEST(Engine, ConcurrentQueriesEqualSequentialOnes) {

@@ -29,11 +29,15 @@ AcousticModelOptions acoustic_preset(const std::string& name, int64_t n_channels
                                      int64_t max_len) {
   AcousticModelOptions o;
   o.max_len = max_len;
-  if (name == "paper") {
+  if (name == "paper" || name == "reference") {
     o.grid.resolution = 128;
     o.grid.cells_per_update = 4096;
     o.resnet = resnet3d_paper_options();
     o.nacf = nacf_paper_options(n_channels, n_freq, resnet3d_out_features(o.resnet));
+    if (name == "reference") {  // the published model exactly: its 18 vectors, its BatchNorm
+      o.grid.view_directions = ViewDirections::kReference;
+      o.resnet.running_stats = true;
+    }
   } else if (name == "cpu") {
     o.grid.resolution = 32;
     // 1024 cells × 18 directions = 18,432 radiance-field queries with autograd per step (the
@@ -43,10 +47,10 @@ AcousticModelOptions acoustic_preset(const std::string& name, int64_t n_channels
     o.resnet = resnet3d_cpu_options();
     o.nacf = nacf_cpu_options(n_channels, n_freq, resnet3d_out_features(o.resnet));
     o.nacf.bf16 = true;               // training follows --precision (infer::audio_model_options)
-    o.nacf.relative_geometry = true;  // extent_m from the data (infer::audio_model_options)
+    o.nacf.relative_geometry = true;  // box from the data (infer::audio_model_options)
     o.nacf.position_max_freq_exp = 1.0;  // room-scale positions (train_config.cpp says why)
   } else {
-    throw Error("preset: unknown acoustic preset '" + name + "': use cpu or paper");
+    throw Error("preset: unknown acoustic preset '" + name + "': use cpu, paper or reference");
   }
   return o;
 }
@@ -80,17 +84,17 @@ torch::Tensor AcousticModelImpl::scene_feature(const torch::Tensor& grid) {
 
 torch::Tensor AcousticModelImpl::forward_with_feature(const torch::Tensor& feature,
                                                       const torch::Tensor& t,
-                                                      const torch::Tensor& mic_norm,
-                                                      const torch::Tensor& src_norm,
+                                                      const torch::Tensor& mic_m,
+                                                      const torch::Tensor& src_m,
                                                       const torch::Tensor& rot) const {
-  return field_->forward(nacf_input(options_.nacf, feature, t, options_.max_len, mic_norm, src_norm,
+  return field_->forward(nacf_input(options_.nacf, feature, t, options_.max_len, mic_m, src_m,
                                     rot));  // [B, C, F]
 }
 
 torch::Tensor AcousticModelImpl::forward(const torch::Tensor& grid, const torch::Tensor& t,
-                                         const torch::Tensor& mic_norm,
-                                         const torch::Tensor& src_norm, const torch::Tensor& rot) {
-  return forward_with_feature(scene_feature(grid), t, mic_norm, src_norm, rot);
+                                         const torch::Tensor& mic_m, const torch::Tensor& src_m,
+                                         const torch::Tensor& rot) {
+  return forward_with_feature(scene_feature(grid), t, mic_m, src_m, rot);
 }
 
 namespace {
@@ -116,27 +120,25 @@ torch::Tensor pose_row(const torch::Tensor& x, const char* name) {
 }  // namespace
 
 torch::Tensor AcousticModelImpl::render_stft_with_feature(const torch::Tensor& feature,
-                                                          const torch::Tensor& mic_norm,
-                                                          const torch::Tensor& src_norm,
+                                                          const torch::Tensor& mic_m,
+                                                          const torch::Tensor& src_m,
                                                           const torch::Tensor& rot) const {
   torch::NoGradGuard no_grad;  // thread-local; NAcF needs no eval mode (no BatchNorm or dropout)
   const int64_t n = options_.max_len;
   const auto device = field_->parameters().front().device();
   const auto t = torch::arange(n, torch::dtype(torch::kInt64).device(device));
-  const auto mic = pose_row(mic_norm, "mic").expand({n, 3});
-  const auto src = pose_row(src_norm, "source").expand({n, 3});
+  const auto mic = pose_row(mic_m, "mic").expand({n, 3});
+  const auto src = pose_row(src_m, "source").expand({n, 3});
   const auto r = pose_row(rot, "rot").expand({n, 3});
   const auto out = forward_with_feature(feature, t, mic, src, r);  // [T, C, F]
   return out.permute({1, 2, 0}).contiguous();                      // [C, F, T]
 }
 
-torch::Tensor AcousticModelImpl::render_stft(const torch::Tensor& grid,
-                                             const torch::Tensor& mic_norm,
-                                             const torch::Tensor& src_norm,
-                                             const torch::Tensor& rot) {
+torch::Tensor AcousticModelImpl::render_stft(const torch::Tensor& grid, const torch::Tensor& mic_m,
+                                             const torch::Tensor& src_m, const torch::Tensor& rot) {
   torch::NoGradGuard no_grad;
   EvalScope eval(*this);
-  return render_stft_with_feature(scene_feature(grid), mic_norm, src_norm, rot);
+  return render_stft_with_feature(scene_feature(grid), mic_m, src_m, rot);
 }
 
 }  // namespace neraf::acoustic

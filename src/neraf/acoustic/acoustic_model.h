@@ -12,7 +12,9 @@
 // Presets (acoustic_preset): "paper" = grid 128³, ResNet3D-50/layer3 (1024 features), NAcF
 // 1187→5096→2048→1024→1024→512, 4096 cells per grid update; "cpu" = grid 32³ with 1024 cells per
 // update, small BasicBlock ResNet3D (256 features), NAcF 5×512 (the paper's text) with the
-// relative-geometry inputs (nacf.h), bf16 trunk matrix products.
+// relative-geometry inputs (nacf.h), bf16 trunk matrix products; "reference" = "paper" with the
+// published grid sampler's 18 viewing directions and ResNet3D's BatchNorm with running statistics
+// (the published model exactly; paper keeps our spread directions and per-grid statistics).
 #include <torch/nn/module.h>
 #include <torch/nn/pimpl.h>
 #include <torch/types.h>
@@ -38,7 +40,7 @@ struct AcousticModelOptions {
   int64_t max_len = 78;  // frames per RIR (time normalisation t/(max_len − 1)); set from the data
 };
 
-// name: "cpu" | "paper"; n_channels C, n_freq F and max_len come from the dataset.
+// name: "cpu" | "paper" | "reference"; n_channels C, n_freq F and max_len come from the dataset.
 AcousticModelOptions acoustic_preset(const std::string& name, int64_t n_channels, int64_t n_freq,
                                      int64_t max_len);
 
@@ -51,29 +53,30 @@ class AcousticModelImpl : public torch::nn::Module {
   torch::Tensor scene_feature(const torch::Tensor& grid);
 
   // grid: [7, S, S, S] (ignored for kZeros/kNone; may be undefined there); t: [B] int64 frame
-  // indices; mic_norm, src_norm: [B, 3] normalised positions; rot: [B, 3] stored orientation.
+  // indices; mic_m, src_m: [B, 3] positions in metres (float64 advised; normalised here by
+  // options().nacf's box, nacf_input); rot: [B, 3] stored orientation.
   // → [B, C, F] predicted log-magnitudes. ResNet3D runs on every call (the reference re-runs it on
   // every audio step; its gradient reaches the freshly written grid cells).
   torch::Tensor forward(const torch::Tensor& grid, const torch::Tensor& t,
-                        const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
+                        const torch::Tensor& mic_m, const torch::Tensor& src_m,
                         const torch::Tensor& rot);
   // Same with a precomputed scene feature ([G], or undefined for kNone). Runs NAcF only, which
   // has no BatchNorm or dropout: the same in either mode, and reads no module state but the
   // parameters.
   torch::Tensor forward_with_feature(const torch::Tensor& feature, const torch::Tensor& t,
-                                     const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
+                                     const torch::Tensor& mic_m, const torch::Tensor& src_m,
                                      const torch::Tensor& rot) const;
 
-  // All frames t = 0..max_len−1 of one pose (mic_norm, src_norm, rot: [3] or [1, 3]) → [C, F, T].
+  // All frames t = 0..max_len−1 of one pose (mic_m, src_m in metres, rot: [3] or [1, 3]) →
+  // [C, F, T].
   // No autograd, ResNet3D and NAcF in eval mode (the previous mode is restored), one batch of T.
-  torch::Tensor render_stft(const torch::Tensor& grid, const torch::Tensor& mic_norm,
-                            const torch::Tensor& src_norm, const torch::Tensor& rot);
+  torch::Tensor render_stft(const torch::Tensor& grid, const torch::Tensor& mic_m,
+                            const torch::Tensor& src_m, const torch::Tensor& rot);
   // Same from a scene feature computed once (in eval mode) for many RIRs: the inference query.
   // NAcF only, so no train/eval switch is needed and none is made; with the thread-local
   // NoGradGuard it touches no shared state and may run from several threads at once.
-  torch::Tensor render_stft_with_feature(const torch::Tensor& feature,
-                                         const torch::Tensor& mic_norm,
-                                         const torch::Tensor& src_norm,
+  torch::Tensor render_stft_with_feature(const torch::Tensor& feature, const torch::Tensor& mic_m,
+                                         const torch::Tensor& src_m,
                                          const torch::Tensor& rot) const;
 
   const AcousticModelOptions& options() const { return options_; }

@@ -65,16 +65,25 @@ torch::Tensor encode_rot(const torch::Tensor& rot) {
   return nerf::sh_encode_tcnn_input(rot.to(torch::kFloat64), 4).to(torch::kFloat32);
 }
 
-torch::Tensor encode_relative_geometry(const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
+torch::Tensor normalize_to_box(const torch::Tensor& p_m, const std::array<double, 3>& box_min,
+                               const std::array<double, 3>& box_max) {
+  check_pose_batch(p_m, "position");
+  const auto f64 = torch::TensorOptions().dtype(torch::kFloat64).device(p_m.device());
+  const auto lo = torch::tensor({box_min[0], box_min[1], box_min[2]}, f64);
+  const auto hi = torch::tensor({box_max[0], box_max[1], box_max[2]}, f64);
+  const auto q = (p_m.to(torch::kFloat64) - lo) / (hi - lo);
+  const auto inside = ((q > 0) & (q < 1)).all(1, /*keepdim=*/true);
+  return q * inside.to(torch::kFloat64);
+}
+
+torch::Tensor encode_relative_geometry(const torch::Tensor& mic_m, const torch::Tensor& src_m,
                                        const torch::Tensor& rot,
                                        const std::array<double, 3>& extent_m) {
-  check_pose_batch(mic_norm, "mic");
-  check_pose_batch(src_norm, "source");
+  check_pose_batch(mic_m, "mic");
+  check_pose_batch(src_m, "source");
   check_pose_batch(rot, "rot");
-  const auto f64 = torch::TensorOptions().dtype(torch::kFloat64).device(mic_norm.device());
-  const auto extent = torch::tensor({extent_m[0], extent_m[1], extent_m[2]}, f64);
-  const auto d = (src_norm.to(torch::kFloat64) - mic_norm.to(torch::kFloat64)) * extent;  // [B,3]
-  const auto dx = d.select(1, 0), dy = d.select(1, 1), dz = d.select(1, 2);               // [B]
+  const auto d = src_m.to(torch::kFloat64) - mic_m.to(torch::kFloat64);      // [B, 3] metres
+  const auto dx = d.select(1, 0), dy = d.select(1, 1), dz = d.select(1, 2);  // [B]
   const auto dist = d.norm(2, 1).clamp_min(0.05);
   const auto horizontal = (dx * dx + dz * dz).sqrt();
   const auto r = rot.to(torch::kFloat64);
@@ -120,12 +129,14 @@ torch::Tensor nacf_input(const torch::Tensor& grid_feature, const torch::Tensor&
 }
 
 torch::Tensor nacf_input(const NacfOptions& options, const torch::Tensor& grid_feature,
-                         const torch::Tensor& t, int64_t max_len, const torch::Tensor& mic_norm,
-                         const torch::Tensor& src_norm, const torch::Tensor& rot) {
-  const torch::Tensor h = nacf_input(grid_feature, t, max_len, mic_norm, src_norm, rot,
+                         const torch::Tensor& t, int64_t max_len, const torch::Tensor& mic_m,
+                         const torch::Tensor& src_m, const torch::Tensor& rot) {
+  const torch::Tensor h = nacf_input(grid_feature, t, max_len,
+                                     normalize_to_box(mic_m, options.box_min, options.box_max),
+                                     normalize_to_box(src_m, options.box_min, options.box_max), rot,
                                      options.position_max_freq_exp);  // [B, G + 163]
   if (!options.relative_geometry) return h;
-  return torch::cat({h, encode_relative_geometry(mic_norm, src_norm, rot, options.extent_m)}, 1);
+  return torch::cat({h, encode_relative_geometry(mic_m, src_m, rot, options.extent_m())}, 1);
 }
 
 NacfImpl::NacfImpl(NacfOptions options) : options_(std::move(options)) {

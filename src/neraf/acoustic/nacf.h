@@ -7,8 +7,9 @@
 // 1024 for preset paper → 1187 inputs. Without a grid (use_grid = false, an ablation) the reference
 // order is [mic, source, time, rot] → 163 inputs.
 //   time:      t/(max_len − 1) → NeRFEncoding(1 dim, 10 freqs, 0..8, include_input) → 21
-//   positions: normalised by the audio aabb into (0,1)³, zero vector when outside (done by the data
-//              stage) → one shared NeRFEncoding(3 dims) → 63 each
+//   positions: metres, normalised by the audio aabb into (0,1)³, zero vector when outside (the
+//              reference's data-stage rule, normalize_to_box) → one shared NeRFEncoding(3 dims) →
+//              63 each
 //   rot:       ((cosθ+1)/2, 0.5, (sinθ+1)/2) → SH degree 4 with tcnn's input mapping 2v − 1 → 16
 // Encodings of positions and rot run in float64 (the reference's dataset tensors are float64), time
 // in float32 (an int tensor divided by an int in torch gives the default dtype); the concatenation
@@ -24,6 +25,9 @@
 // dozen training positions, and held-out headings and off-grid positions generalise poorly
 // (AV-NeRF's coordinate transformation makes the same point). With `relative_geometry` the input
 // gains kRelativeGeometryDim features after the reference's 163 + G (encode_relative_geometry).
+// They are computed from the positions in metres, before normalisation: a source outside the audio
+// box (train mics ± 1 m; common for RAF loudspeakers) has a zero position encoding, as in the
+// reference, but its true direction and distance.
 //
 // Precision: with `bf16` the trunk's matrix products run in bfloat16 (inputs and weights cast per
 // call, fp32 master weights, fp32 gradients), activations between trunk layers stay bf16; the heads
@@ -54,12 +58,19 @@ struct NacfOptions {
   int64_t n_channels = 2;  // C: 2 SoundSpaces binaural, 1 RAF mono
   int64_t n_freq = 257;    // F: 257 SoundSpaces (n_fft 512), 513 RAF (n_fft 1024)
   double leaky_slope = 0.1;
-  double output_scale = 10.0;               // out = output_scale·tanh(h)
-  bool bf16 = false;                        // bf16 trunk matrix products (fp32 master weights)
-  bool relative_geometry = false;           // append encode_relative_geometry (ours)
-  double position_max_freq_exp = 8.0;       // mic/source NeRFEncoding (reference 8)
-  std::array<double, 3> extent_m{1, 1, 1};  // audio aabb size (m): undoes the normalisation
+  double output_scale = 10.0;          // out = output_scale·tanh(h)
+  bool bf16 = false;                   // bf16 trunk matrix products (fp32 master weights)
+  bool relative_geometry = false;      // append encode_relative_geometry (ours)
+  double position_max_freq_exp = 8.0;  // mic/source NeRFEncoding (reference 8)
+  // The audio aabb (m; the data's train mics ± 1 m, set by infer::audio_model_options): positions
+  // are given in metres and normalised by it for the position encodings. The default unit box
+  // makes metres and normalised coordinates the same.
+  std::array<double, 3> box_min{0, 0, 0};
+  std::array<double, 3> box_max{1, 1, 1};
 
+  std::array<double, 3> extent_m() const {
+    return {box_max[0] - box_min[0], box_max[1] - box_min[1], box_max[2] - box_min[2]};
+  }
   int64_t in_features() const {
     return grid_features + kPoseEncodingDim + (relative_geometry ? kRelativeGeometryDim : 0);
   }
@@ -75,20 +86,27 @@ torch::Tensor encode_time(const torch::Tensor& t, int64_t max_len);  // t: [B] i
 torch::Tensor encode_position(const torch::Tensor& p_norm, double max_freq_exp = 8.0);
 torch::Tensor encode_rot(const torch::Tensor& rot);  // [B, 3] → [B, 16]
 
-// The source as heard from the microphone (y up), from the normalised positions, the audio aabb
-// size extent_m (so d = (src − mic)·extent is in metres) and the stored orientation (heading θ
-// from cosθ = 2·rot0 − 1, sinθ = 2·rot2 − 1). With φ the azimuth of d in the x-z plane:
+// The reference's position normalisation (data::normalize_position's rule): p' = (p − min)/(max −
+// min), the whole vector zero when any component lies outside the open interval (0, 1).
+// p_m: [B, 3] metres → [B, 3] float64.
+torch::Tensor normalize_to_box(const torch::Tensor& p_m, const std::array<double, 3>& box_min,
+                               const std::array<double, 3>& box_max);
+
+// The source as heard from the microphone (y up), from the positions in metres (d = src − mic,
+// never the normalised positions, which are zero outside the box), the audio aabb size extent_m
+// (for the relative distance) and the stored orientation (heading θ from cosθ = 2·rot0 − 1,
+// sinθ = 2·rot2 − 1). With φ the azimuth of d in the x-z plane:
 //   cos, sin of k(φ − θ) and of k(φ + θ), k = 1..3  (12: direction relative to the heading; both
 //       senses of rotation because datasets disagree on it, and a constant offset is linear in
 //       these; for a mono RAF set θ is the source's yaw, and φ + π its emission direction)
 //   d_y/|d|, d_xz/|d|                                (2: elevation)
 //   |d|/|extent|, ln(|d| / 1 m), sin, cos(2π·2^k·|d|/|extent|), k = 0..2  (8: distance)
 // → [B, 22] float32 (computed in float64). |d| is clamped to ≥ 5 cm.
-torch::Tensor encode_relative_geometry(const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
+torch::Tensor encode_relative_geometry(const torch::Tensor& mic_m, const torch::Tensor& src_m,
                                        const torch::Tensor& rot,
                                        const std::array<double, 3>& extent_m);
 
-// Builds the NAcF input [B, in_features] float32.
+// Builds the reference's NAcF input [B, G + 163] float32 from normalised positions.
 //   grid_feature: [G] or [1, G] (broadcast to the batch) or [B, G]; undefined → no-grid layout.
 //   t: [B] int64 frame index in [0, max_len); mic_norm, src_norm: [B, 3] normalised positions;
 //   rot: [B, 3] stored orientation ((cosθ+1)/2, 0.5, (sinθ+1)/2). Any float dtype (float64
@@ -97,11 +115,13 @@ torch::Tensor nacf_input(const torch::Tensor& grid_feature, const torch::Tensor&
                          const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
                          const torch::Tensor& rot, double position_max_freq_exp = 8.0);
 
-// Every input a Nacf built with `options` expects: nacf_input with its position frequencies, then
-// (options.relative_geometry) encode_relative_geometry → [B, options.in_features()].
+// Every input a Nacf built with `options` expects, from positions in METRES (mic_m, src_m: [B, 3]):
+// nacf_input of the positions normalised by options' box (normalize_to_box) with its position
+// frequencies, then (options.relative_geometry) encode_relative_geometry of the metres →
+// [B, options.in_features()].
 torch::Tensor nacf_input(const NacfOptions& options, const torch::Tensor& grid_feature,
-                         const torch::Tensor& t, int64_t max_len, const torch::Tensor& mic_norm,
-                         const torch::Tensor& src_norm, const torch::Tensor& rot);
+                         const torch::Tensor& t, int64_t max_len, const torch::Tensor& mic_m,
+                         const torch::Tensor& src_m, const torch::Tensor& rot);
 
 class NacfImpl : public torch::nn::Module {
  public:

@@ -35,16 +35,21 @@ nn::Conv3d conv(int64_t in, int64_t out, int64_t kernel, int64_t stride, int64_t
   return nn::Conv3d(nn::Conv3dOptions(in, out, kernel).stride(stride).padding(padding).bias(false));
 }
 
-// BatchNorm over the one grid of a batch, with that grid's own statistics in train AND eval mode
-// (no running statistics; see resnet3d.h for why).
-nn::BatchNorm3d batch_norm(int64_t channels) {
-  return nn::BatchNorm3d(nn::BatchNorm3dOptions(channels).track_running_stats(false));
+// BatchNorm over the one grid of a batch: with that grid's own statistics in train AND eval mode
+// (no running statistics; see resnet3d.h for why), or, running_stats, as the reference (PyTorch's
+// defaults: running statistics in eval mode, momentum 0.1, eps 1e-5).
+nn::BatchNorm3d make_batch_norm(int64_t channels, bool running_stats) {
+  return nn::BatchNorm3d(nn::BatchNorm3dOptions(channels).track_running_stats(running_stats));
 }
 
 }  // namespace
 
-ResBlock3dImpl::ResBlock3dImpl(ResBlock kind, int64_t in_channels, int64_t planes, int64_t stride)
+ResBlock3dImpl::ResBlock3dImpl(ResBlock kind, int64_t in_channels, int64_t planes, int64_t stride,
+                               bool running_stats)
     : kind_(kind) {
+  auto batch_norm = [running_stats](int64_t channels) {
+    return make_batch_norm(channels, running_stats);
+  };
   const int64_t out_channels = planes * resnet3d_expansion(kind);
   if (kind == ResBlock::kBottleneck) {
     conv1 = register_module("conv1", conv(in_channels, planes, 1, 1, 0));
@@ -87,14 +92,15 @@ ResNet3dImpl::ResNet3dImpl(ResNet3dOptions options) : options_(std::move(options
           "resnet3d: layers, planes and strides must be non-empty and of equal length");
   conv1 = register_module(
       "conv1", conv(o.in_channels, o.stem_channels, o.stem_kernel, 2, o.stem_kernel / 2));
-  bn1 = register_module("bn1", batch_norm(o.stem_channels));
+  bn1 = register_module("bn1", make_batch_norm(o.stem_channels, o.running_stats));
   int64_t in = o.stem_channels;
   for (size_t s = 0; s < o.layers.size(); ++s) {
     require(o.layers[s] >= 1 && o.planes[s] >= 1 && o.strides[s] >= 1,
             "resnet3d: blocks, planes and strides must be positive");
     nn::Sequential stage;
     for (int64_t b = 0; b < o.layers[s]; ++b) {
-      stage->push_back(ResBlock3d(o.block, in, o.planes[s], b == 0 ? o.strides[s] : 1));
+      stage->push_back(
+          ResBlock3d(o.block, in, o.planes[s], b == 0 ? o.strides[s] : 1, o.running_stats));
       in = o.planes[s] * resnet3d_expansion(o.block);
     }
     layers_.push_back(register_module("layer" + std::to_string(s + 1), stage));

@@ -10,8 +10,10 @@
 // layer3) is exactly a global average; we use adaptive average pooling to 1³, identical there and
 // valid at every grid size. Init: Conv3d xavier_normal_, BN weight 1 / bias 0 (eps 1e-5).
 //
-// Deliberate change: BN normalises with the grid's own statistics in train AND eval mode (no
-// running statistics). The reference uses running statistics in eval mode, but its batch is one
+// Deliberate change (default; `running_stats = true` restores the reference, preset `reference`):
+// BN normalises with the grid's own statistics in train AND eval mode (no running statistics).
+// The reference uses running statistics in eval mode (momentum 0.1, updated by every train-mode
+// forward), but its batch is one
 // grid, so they never equal what training saw: the running variance is the unbiased one over as
 // few as 2³ voxels, and in joint training it lags the changing grid. Measured on the demo room:
 // the eval-mode scene feature was 11 % off the train-mode one, which lifted every predicted
@@ -46,6 +48,10 @@ struct ResNet3dOptions {
   std::vector<int64_t> layers = {3, 4, 6};       // blocks per stage
   std::vector<int64_t> planes = {64, 128, 256};  // bottleneck width per stage
   std::vector<int64_t> strides = {1, 2, 2};      // stride of each stage's first block
+  // BatchNorm as the reference: running statistics (buffers running_mean, running_var,
+  // num_batches_tracked; momentum 0.1) used in eval mode. false: the grid's own statistics in
+  // both modes, no buffers (ours, see above).
+  bool running_stats = false;
 };
 
 ResNet3dOptions resnet3d_paper_options();  // ResNet3D-50 truncated after layer3, 1024 features
@@ -56,7 +62,8 @@ int64_t resnet3d_out_features(const ResNet3dOptions& options);
 
 class ResBlock3dImpl : public torch::nn::Module {
  public:
-  ResBlock3dImpl(ResBlock kind, int64_t in_channels, int64_t planes, int64_t stride);
+  ResBlock3dImpl(ResBlock kind, int64_t in_channels, int64_t planes, int64_t stride,
+                 bool running_stats = false);
   torch::Tensor forward(const torch::Tensor& x);
 
  private:

@@ -103,14 +103,18 @@ void register_train(CLI::App& app) {
                   "the frozen field of --vision-run)")
       ->check(CLI::IsMember({"vision", "audio", "joint"}))
       ->capture_default_str();
-  CLI::Option* preset = cmd->add_option("--preset", args->preset, "Model and schedule preset")
-                            ->check(CLI::IsMember({"cpu", "paper"}))
-                            ->capture_default_str();
+  CLI::Option* preset =
+      cmd->add_option("--preset", args->preset,
+                      "Model and schedule preset: cpu (sized for a few CPU cores, with neraf's "
+                      "additions), paper (the published sizes and schedule), reference (the "
+                      "published model exactly: its grid directions and BatchNorm too)")
+          ->check(CLI::IsMember({"cpu", "paper", "reference"}))
+          ->capture_default_str();
   CLI::Option* steps =
       cmd->add_option("--steps", args->steps,
                       "Total training steps (default: cpu 3000 joint, 2000 vision, 1500 audio; "
-                      "paper 400001 joint, 30000 vision, 398000 audio). With --resume: train on to "
-                      "this step")
+                      "paper, reference 400001 joint, 30000 vision, 398000 audio). With --resume: "
+                      "train on to this step")
           ->transform(whole_number(1, kMaxSteps));
   CLI::Option* seed = cmd->add_option("--seed", args->seed, "Random seed")
                           ->transform(seed_number())
@@ -146,7 +150,7 @@ void register_train(CLI::App& app) {
       "the grid (frozen)");
   CLI::Option* audio_start = cmd->add_option("--audio-start-step", args->audio_start,
                                              "Audio losses start after this step (default: the "
-                                             "preset's; cpu 1000, paper 2000; audio "
+                                             "preset's; cpu 1000, paper and reference 2000; audio "
                                              "modality 0)")
                                  ->transform(whole_number(-1, kMaxSteps));
   CLI::Option* decay_loss =
@@ -229,7 +233,7 @@ void register_train(CLI::App& app) {
       for (CLI::Option* o : {args->cache_dir_opt, args->cache_precision_opt})
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json records "
-                                     "the cache); start a new run with --out to change it");
+                                     "it); start a new run with --out to change it");
       if (steps->count()) opts.steps = args->steps;
       if (threads->count()) opts.threads = args->threads;
     }

@@ -8,8 +8,8 @@
 #include <filesystem>
 
 #include "neraf/acoustic/calibration.h"
-#include "neraf/infer/calibration.h"
 #include "neraf/dsp/griffin_lim.h"
+#include "neraf/infer/calibration.h"
 #include "neraf/infer/checkpoint.h"
 #include "neraf/io/json_file.h"
 #include "neraf/util/error.h"
@@ -101,9 +101,9 @@ void check_audio_manifest(const nlohmann::json& manifest, const data::RirSet& ri
   for (const char* key :
        {"layout", "num_rirs", "num_train", "hash", "channels", "n_freq", "max_len"})
     require(manifest.value(key, nlohmann::json()) == now[key],
-            where + ": was trained on another RIR dataset (" + key +
-                " differs: " + manifest.value(key, nlohmann::json()).dump() + " vs " +
-                now[key].dump() + "); use the original --data (or, for neraf train, a new --out folder)");
+            where + ": was trained on another RIR dataset (" + key + " differs: " +
+                manifest.value(key, nlohmann::json()).dump() + " vs " + now[key].dump() +
+                "); use the original --data (or, for neraf train, a new --out folder)");
 }
 
 void check_same_room_format(const nlohmann::json& manifest, const data::RirSet& rirs,
@@ -127,19 +127,21 @@ acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, in
   o.grid.resolution = a.grid_resolution;
   o.grid.cells_per_update = a.cells_per_update;
   if (a.nacf_width > 0) o.nacf.trunk.assign(static_cast<size_t>(a.nacf_layers), a.nacf_width);
+  o.grid.view_directions = acoustic::parse_view_directions(a.view_directions);
+  o.resnet.running_stats = a.resnet_batch_norm == "running";
   // The NAcF trunk follows --precision, as the radiance field's MLPs.
   o.nacf.bf16 = config.model.precision == nerf::Precision::bf16;
   o.nacf.relative_geometry = a.relative_geometry;
   o.nacf.position_max_freq_exp = a.position_max_freq_exp;
-  const geometry::Vec3& lo = audio_aabb.min;
-  const geometry::Vec3& hi = audio_aabb.max;
-  o.nacf.extent_m = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
+  o.nacf.box_min = {audio_aabb.min.x, audio_aabb.min.y, audio_aabb.min.z};
+  o.nacf.box_max = {audio_aabb.max.x, audio_aabb.max.y, audio_aabb.max.z};
   return o;
 }
 
 std::vector<int64_t> audio_train_subset(const data::RirSet& rirs, double fraction, uint64_t seed) {
-  require(fraction > 0 && fraction <= 1, "the audio fraction (neraf train --audio-fraction) must be in (0, 1], not " +
-                                               std::to_string(fraction));
+  require(fraction > 0 && fraction <= 1,
+          "the audio fraction (neraf train --audio-fraction) must be in (0, 1], not " +
+              std::to_string(fraction));
   std::vector<int64_t> all = rirs.train;
   if (fraction >= 1.0 || all.empty()) return all;
   const int64_t n = static_cast<int64_t>(all.size());
@@ -153,29 +155,26 @@ std::vector<int64_t> audio_train_subset(const data::RirSet& rirs, double fractio
   return out;
 }
 
-torch::Tensor AudioRun::predict_normalised(const torch::Tensor& mic_norm,
-                                           const torch::Tensor& src_norm,
-                                           const torch::Tensor& rot) const {
-  const torch::Tensor raw = model_->render_stft_with_feature(feature_, mic_norm, src_norm, rot);
+torch::Tensor AudioRun::predict_pose(const torch::Tensor& mic_m, const torch::Tensor& src_m,
+                                     const torch::Tensor& rot) const {
+  const torch::Tensor raw = model_->render_stft_with_feature(feature_, mic_m, src_m, rot);
   return calibration_.defined() ? acoustic::apply_calibration(raw, calibration_)
                                 : raw;  // [C, F, T]
 }
 
 torch::Tensor AudioRun::predict_log_stft_batch(const torch::Tensor& mic, const torch::Tensor& src,
                                                const torch::Tensor& yaw_deg) const {
-  const torch::Tensor mn = data::normalize_position(mic.to(torch::kFloat64), info_.aabb);
-  const torch::Tensor sn = data::normalize_position(src.to(torch::kFloat64), info_.aabb);
+  const torch::Tensor m = mic.to(torch::kFloat64), s = src.to(torch::kFloat64);
   const torch::Tensor th = yaw_deg.to(torch::kFloat64) * (M_PI / 180.0);
   const torch::Tensor rot = torch::stack(
       {(torch::cos(th) + 1) / 2, torch::full_like(th, 0.5), (torch::sin(th) + 1) / 2}, 1);
   std::vector<torch::Tensor> out;
-  for (int64_t i = 0; i < mn.size(0); ++i) out.push_back(predict_normalised(mn[i], sn[i], rot[i]));
+  for (int64_t i = 0; i < m.size(0); ++i) out.push_back(predict_pose(m[i], s[i], rot[i]));
   return torch::stack(out);  // [N, C, F, T]
 }
 
 AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
-                        const std::string& checkpoint, nerf::Precision precision,
-                        bool calibrated) {
+                        const std::string& checkpoint, nerf::Precision precision, bool calibrated) {
   std::error_code ec;
   const std::string config_path = (fs::path(run_dir) / "config.json").string();
   const std::string manifest_path = (fs::path(run_dir) / "data.json").string();
@@ -230,8 +229,10 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
       else if (branch.try_read("calibration", legacy))
         out.calibration_ = legacy.toTensor().to(device);
       else
-        warn(out.run_.checkpoint + ": not calibrated (training stopped before its calibration "
-             "stage); predictions are uncalibrated until you run: neraf calibrate --run " + run_dir);
+        warn(out.run_.checkpoint +
+             ": not calibrated (training stopped before its calibration "
+             "stage); predictions are uncalibrated until you run: neraf calibrate --run " +
+             run_dir);
     }
   } catch (const c10::Error& e) {
     std::string what = e.what_without_backtrace();

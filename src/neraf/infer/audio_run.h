@@ -12,8 +12,9 @@
 //   std::vector<std::vector<float>> wave = run.predict_waveform(mic, src, yaw);  // GL, C channels
 // Positions are in the DATASET's frame in metres (SoundSpaces: [x, z, −y] of points.txt, as the
 // RirSet; RAF as written), yaw in degrees (the receiver heading for SoundSpaces, the source yaw for
-// RAF), encoded as ((cos+1)/2, 0.5, (sin+1)/2). Positions outside the train audio aabb are zeroed
-// (the reference's rule) — the prediction is then meaningless; check info().aabb.
+// RAF), encoded as ((cos+1)/2, 0.5, (sin+1)/2). Positions outside the train audio aabb get a zero
+// position encoding (the reference's rule) — the prediction is then unreliable; check info().aabb.
+// The relative-geometry inputs (presets cpu) are computed from the metres, so they stay right.
 // Batch many poses with predict_log_stft_batch (one NAcF call per pose, the scene feature is
 // computed once at load). Queries run NAcF in fp32 whatever precision trained the run (unless
 // load_audio_run is asked for bf16).
@@ -54,8 +55,8 @@ void check_same_room_format(const nlohmann::json& manifest, const data::RirSet& 
                             const std::string& where);
 
 // The acoustic model options of a run: the preset's (`config.preset`) sized to the data, with the
-// AudioConfig overrides (grid mode, resolution, cells per update, NAcF width, relative geometry
-// in the metres of `audio_aabb`).
+// AudioConfig overrides (grid mode, resolution, cells per update, NAcF width, relative geometry)
+// and `audio_aabb` as the box NAcF normalises positions by.
 acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, int64_t channels,
                                                    int64_t n_freq, int64_t max_len,
                                                    const data::Aabb& audio_aabb);
@@ -76,10 +77,10 @@ class AudioRun final : public AudioField {
   torch::Tensor predict_log_stft_batch(const torch::Tensor& mic, const torch::Tensor& src,
                                        const torch::Tensor& yaw_deg) const override;
 
-  // Low level: normalised inputs (mic_norm, src_norm, rot: [3] each) → [C, F, T], with the
-  // energy calibration applied when the run was loaded with one.
-  torch::Tensor predict_normalised(const torch::Tensor& mic_norm, const torch::Tensor& src_norm,
-                                   const torch::Tensor& rot) const;
+  // Low level: one pose (mic_m, src_m: [3] metres, float64; rot: [3] as the RirSet stores it) →
+  // [C, F, T], with the energy calibration applied when the run was loaded with one.
+  torch::Tensor predict_pose(const torch::Tensor& mic_m, const torch::Tensor& src_m,
+                             const torch::Tensor& rot) const;
 
   // What a query reads, for exporting the model: the acoustic model (eval mode; read-only), the
   // [G] scene feature (undefined for grid mode none) and the [C, F, T] energy gains (undefined

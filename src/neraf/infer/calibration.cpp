@@ -29,12 +29,9 @@ torch::Tensor fit_calibration(const AudioRun& run, const data::RirSet& rirs) {
   std::vector<std::pair<int64_t, torch::Tensor>> preds;  // (RIR, [C, F, T]) for the balance
   for (int64_t k = 0; k < n; k += stride) {
     const int64_t i = train[static_cast<size_t>(k)];
-    const torch::Tensor idx = torch::tensor({i}, torch::kInt64);
-    const torch::Tensor mic =
-        data::normalize_position(rirs.mic_positions.index_select(0, idx), rirs.audio_aabb)[0];
-    const torch::Tensor src =
-        data::normalize_position(rirs.source_positions.index_select(0, idx), rirs.audio_aabb)[0];
-    const torch::Tensor pred = run.predict_normalised(mic, src, rirs.rots[i]).cpu();  // [C, F, T]
+    const torch::Tensor pred =
+        run.predict_pose(rirs.mic_positions[i], rirs.source_positions[i], rirs.rots[i])
+            .cpu();  // [C, F, T]
     pred_energy += acoustic::bin_energy(pred);
     gt_energy += acoustic::bin_energy(rirs.features(i));
     if ((k / stride) % balance_stride == 0) preds.emplace_back(i, pred);
@@ -49,9 +46,9 @@ torch::Tensor fit_calibration(const AudioRun& run, const data::RirSet& rirs) {
   for (size_t r = 0; r < preds.size(); ++r) {
     const auto& [i, pred] = preds[r];
     const torch::Tensor gt = rirs.waveform(i).contiguous();  // [C, L]
-    const auto wave = griffin_lim_channels(
-        log_stft_to_magnitude(acoustic::apply_calibration(pred, gain)), rirs.stft,
-        config.seed + r, gt.size(1));
+    const auto wave =
+        griffin_lim_channels(log_stft_to_magnitude(acoustic::apply_calibration(pred, gain)),
+                             rirs.stft, config.seed + r, gt.size(1));
     for (int64_t c = 0; c < C; ++c) {
       const float* g = gt[c].data_ptr<float>();
       const double d = metrics::measure_c50(std::vector<float>(g, g + gt.size(1)), fs) -
@@ -89,7 +86,8 @@ std::optional<torch::Tensor> load_calibration(const std::string& checkpoint, int
     throw Error(path + ": not a calibration file; delete it and run neraf calibrate");
   }
   require(stored_step.numel() == 1 && stored_step.item<int64_t>() == step,
-          path + ": fitted for another step than " + checkpoint + "; delete it and run neraf calibrate");
+          path + ": fitted for another step than " + checkpoint +
+              "; delete it and run neraf calibrate");
   require(gains.dim() == 3 && torch::isfinite(gains).all().item<bool>(),
           path + ": damaged gains; delete it and run neraf calibrate");
   return gains;

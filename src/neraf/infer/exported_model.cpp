@@ -76,7 +76,7 @@ rt::ModelData export_model_data(const AudioRun& run, const ExportOptions& option
   m.box_max = {info.aabb.max.x, info.aabb.max.y, info.aabb.max.z};
   m.relative_geometry = no.relative_geometry;
   m.position_max_freq_exp = no.position_max_freq_exp;
-  m.extent_m = no.extent_m;
+  m.extent_m = no.extent_m();
   m.leaky_slope = no.leaky_slope;
   m.output_scale = no.output_scale;
   m.bf16_storage = options.bf16;

@@ -30,11 +30,14 @@ Modality parse_enum(Modality, const std::string& s, const std::string& where) {
 
 Modality parse_modality(const std::string& s) { return parse_enum(Modality{}, s, "--modality"); }
 
+bool published_sizes(const std::string& name) { return name == "paper" || name == "reference"; }
+
 TrainConfig train_preset(const std::string& name) {
   TrainConfig c;
-  c.model = nerf::model_preset(name);  // validates the name
+  // The radiance field of reference is paper's (the Nerfacto configuration NeRAF trains).
+  c.model = nerf::model_preset(name == "reference" ? "paper" : name);  // validates the name
   c.preset = name;
-  if (name == "paper") {
+  if (published_sizes(name)) {
     c.steps = 30000;  // nerfstudio's nerfacto; NeRAF runs 400k joint steps
     c.rays_per_batch = 4096;
     c.save_every = 2000;
@@ -43,8 +46,13 @@ TrainConfig train_preset(const std::string& name) {
     c.audio.cells_per_update = 4096;
     c.audio.batch_size = 2048;
     c.audio.start_step = 2000;
-    c.audio.energy_calibration = false;  // the reference renders the raw prediction
-    c.audio.relative_geometry = false;   // the reference's NAcF input
+    c.audio.energy_calibration = false;   // the reference renders the raw prediction
+    c.audio.relative_geometry = false;    // the reference's NAcF input
+    c.audio.position_max_freq_exp = 8.0;  // the reference's position encoding (2^8)
+    if (name == "reference") {
+      c.audio.view_directions = "reference";  // its 18 degenerate vectors
+      c.audio.resnet_batch_norm = "running";  // running statistics in eval mode
+    }
     return c;
   }
   // cpu: a few thousand steps. The learning rate decays over the run itself (nerfstudio's
@@ -91,7 +99,7 @@ void set_run_length(TrainConfig& c, int64_t steps) {
 TrainConfig resolve_train_config(const TrainFlags& f) {
   TrainConfig cfg = train_preset(f.preset);
   cfg.modality = f.modality;
-  const bool paper = f.preset == "paper";
+  const bool paper = published_sizes(f.preset);
   if (cfg.modality == Modality::joint && paper)
     cfg.steps = 400001;  // NeRAF's max_num_iterations (audio from step 2001)
   if (cfg.modality == Modality::audio) {
@@ -170,6 +178,10 @@ void validate(const TrainConfig& c, const std::string& where) {
   const AudioConfig& a = c.audio;
   require(a.grid == "sampled" || a.grid == "none" || a.grid == "zeros",
           where + ".audio.grid: use sampled, none or zeros (--grid)");
+  require(a.view_directions == "spread" || a.view_directions == "reference",
+          where + ".audio.view_directions: use spread or reference (--preset reference sets it)");
+  require(a.resnet_batch_norm == "grid" || a.resnet_batch_norm == "running",
+          where + ".audio.resnet_batch_norm: use grid or running (--preset reference sets it)");
   require(a.batch_size >= 1, where + ".audio.batch_size: must be at least 1");
   require(a.grid_resolution >= 8, where + ".audio.grid_resolution: must be at least 8");
   require(a.cells_per_update >= 1, where + ".audio.cells_per_update: must be at least 1");

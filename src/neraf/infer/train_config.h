@@ -1,6 +1,7 @@
 #pragma once
-// Training configuration: presets `cpu` (default) and `paper`, resolved once and saved beside the
-// run as RUN/config.json (JSON round trip through the same field tables as the model config).
+// Training configuration: presets `cpu` (default), `paper` and `reference`, resolved once and saved
+// beside the run as RUN/config.json (JSON round trip through the same field tables as the model
+// config).
 // It lives in infer/ because loading a finished run reads it; `neraf train` resolves it from its
 // flags with resolve_train_config (the one place the per-modality preset rules live).
 #include <cstdint>
@@ -69,6 +70,12 @@ struct AudioConfig {
   bool relative_geometry = true;
   // Highest frequency exponent of the mic/source position encoding (reference 8).
   double position_max_freq_exp = 8.0;
+  // The grid sampler's 18 viewing directions: "spread" (ours: unit vectors spread over the
+  // sphere) or "reference" (the published code's degenerate vectors; acoustic/grid_sampler.h).
+  std::string view_directions = "spread";
+  // ResNet3D's BatchNorm: "grid" (ours: the grid's own statistics in train and eval mode) or
+  // "running" (the reference: running statistics in eval mode; acoustic/resnet3d.h).
+  std::string resnet_batch_norm = "grid";
   std::string vision_run;  // modality audio: the finished vision run whose field is frozen
   // The RIR feature cache (data::RirLoadOptions): its folder ("" = <dataset>/.neraf_cache,
   // --cache-dir) and precision ("fp32", or "fp16": half the disk, features rounded to ~1e-3
@@ -99,6 +106,8 @@ struct AudioConfig {
     v("vision_run", vision_run);
     v("cache_dir", cache_dir);
     v("cache_precision", cache_precision);
+    v("view_directions", view_directions);
+    v("resnet_batch_norm", resnet_batch_norm);
     v("schedule", schedule);
   }
 };
@@ -139,13 +148,21 @@ struct TrainConfig {
 // Sets c.steps; schedules whose decay was tied to the run length (max_steps == c.steps) follow.
 void set_run_length(TrainConfig& c, int64_t steps);
 
-// The named preset (throws neraf::Error naming --preset for unknown names).
+// The named preset (throws neraf::Error naming --preset for unknown names):
+//   paper      the published sizes and schedule, with our grid sampler directions and BatchNorm
+//   reference  the published model exactly: paper plus the reference's 18 viewing directions and
+//              ResNet3D BatchNorm with running statistics (like paper: no energy calibration, no
+//              relative geometry, the reference position encoding)
+//   cpu        sized for 2 CPU cores, with our additions (docs/ARCHITECTURE.md)
 TrainConfig train_preset(const std::string& name);
 
 // What `neraf train` was asked for; an unset optional takes the preset's value for the modality.
 struct TrainFlags {
   std::string preset = "cpu";                // --preset
   Modality modality = Modality::joint;       // --modality
+// Whether `name` uses the published sizes and run lengths (paper, reference).
+bool published_sizes(const std::string& name);
+
   std::optional<int64_t> steps;              // --steps
   uint64_t seed = 42;                        // --seed
   std::optional<int> threads;                // --threads
@@ -161,12 +178,12 @@ struct TrainFlags {
 
 // The config a new run trains with: train_preset(flags.preset), then the modality's defaults,
 // then the flags, in this order:
-//   - run length: cpu joint 3000 steps, vision 2000, audio 1500; paper joint 400001 (NeRAF's
-//     max_num_iterations), vision 30000, audio 398000. cpu schedules whose decay is tied to the
-//     run length follow it (set_run_length), as they follow --steps.
+//   - run length: cpu joint 3000 steps, vision 2000, audio 1500; paper and reference joint
+//     400001 (NeRAF's max_num_iterations), vision 30000, audio 398000. cpu schedules whose decay is
+//     tied to the run length follow it (set_run_length), as they follow --steps.
 //   - modality audio (the field is final, the grid is filled once): audio from the first step
-//     (start_step −1) after a warm-up of 100 steps (cpu) or 2000 (paper), capped at half the
-//     audio schedule's length so that a short run still gets a (shorter) warm-up.
+//     (start_step −1) after a warm-up of 100 steps (cpu) or 2000 (paper, reference), capped at half
+//     the audio schedule's length so that a short run still gets a (shorter) warm-up.
 //   - --steps N sets the run length (set_run_length) before that cap.
 //   - --audio-start-step S: start_step = S, and a warm-up that ended where audio started still
 //     ends there (max(0, S)).

@@ -14,7 +14,7 @@
 namespace neraf::rt {
 namespace {
 
-constexpr float kFloor = 1e-3f;     // the log-magnitude offset: log(|STFT| + 1e-3)
+constexpr float kFloor = 1e-3f;        // the log-magnitude offset: log(|STFT| + 1e-3)
 constexpr float kMaxMagnitude = 1e4f;  // acoustic::log_stft_to_magnitude's clip
 
 // clip(e^x − 1e-3, 0, 1e4) (acoustic::log_stft_to_magnitude).
@@ -119,8 +119,10 @@ void Engine::encode_pose(const neraf_pose& pose, float* out) const {
   encode_position(mic, position_freqs_, enc);
   encode_position(src, position_freqs_, enc + kPositionDim);
   encode_rot(rot, enc + 2 * kPositionDim);
-  if (relative_geometry_)
-    encode_relative_geometry(mic, src, rot, extent_m_, enc + 2 * kPositionDim + kRotDim);
+  if (relative_geometry_)  // from the metres: a source outside the box keeps its direction
+    encode_relative_geometry({pose.mic[0], pose.mic[1], pose.mic[2]},
+                             {pose.source[0], pose.source[1], pose.source[2]}, rot, extent_m_,
+                             enc + 2 * kPositionDim + kRotDim);
   for (int i = 0; i < pose_dim_; ++i) out[i] = static_cast<float>(enc[i]);
 }
 
@@ -183,7 +185,8 @@ void Engine::query(const neraf_pose& pose, Workspace& ws, float* log, float* wav
     if (!wave) n_workers = 1;
   }
   for (int w = 1; w < n_workers; ++w) {
-    ws.channel_parts_[w - 1] = {this, &ws, x, ld, width, log, wave, w, n_workers, heads_per_channel};
+    ws.channel_parts_[w - 1] = {this, &ws,  x, ld,        width,
+                                log,  wave, w, n_workers, heads_per_channel};
     ws.helpers_[w - 1]->start(
         [](void* p) {
           const ChannelPart& part = *static_cast<const ChannelPart*>(p);
@@ -233,8 +236,8 @@ void Engine::layer_columns(const LayerPart& p) const {
   } else {
     // y[T, columns] = x[T, in]·W[columns, in]ᵀ.
     const Layer& l = layers_[p.layer];
-    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, n_frames_, p.n_end - p.n_begin, l.in,
-                1.0f, p.x, int(p.ld_x), l.weight.data() + size_t(p.n_begin) * l.in, l.in, 0.0f,
+    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, n_frames_, p.n_end - p.n_begin, l.in, 1.0f,
+                p.x, int(p.ld_x), l.weight.data() + size_t(p.n_begin) * l.in, l.in, 0.0f,
                 p.y + p.n_begin, int(p.ld_y));
   }
 }

@@ -34,8 +34,7 @@ std::array<double, 3> rot_from_yaw(double yaw_deg) {
   return {(std::cos(th) + 1) / 2, 0.5, (std::sin(th) + 1) / 2};
 }
 
-void encode_time(int t, int n_frames, const std::array<float, kNumFrequencies>& freqs,
-                 float* out) {
+void encode_time(int t, int n_frames, const std::array<float, kNumFrequencies>& freqs, float* out) {
   const float x = static_cast<float>(t) / static_cast<float>(n_frames - 1);
   const float scaled = x * static_cast<float>(2.0 * M_PI);
   const float half_pi = static_cast<float>(M_PI / 2.0);
@@ -47,14 +46,14 @@ void encode_time(int t, int n_frames, const std::array<float, kNumFrequencies>& 
   out[2 * kNumFrequencies] = x;
 }
 
-void encode_position(const std::array<double, 3>& p, const std::array<float, kNumFrequencies>& freqs,
-                     double* out) {
+void encode_position(const std::array<double, 3>& p,
+                     const std::array<float, kNumFrequencies>& freqs, double* out) {
   const int n = kNumFrequencies;
   for (int d = 0; d < 3; ++d) {
     const double scaled = p[d] * (2.0 * M_PI);
     for (int k = 0; k < n; ++k) {
       const double s = scaled * double(freqs[k]);
-      out[d * n + k] = std::sin(s);                    // all sines, dim-major
+      out[d * n + k] = std::sin(s);                       // all sines, dim-major
       out[3 * n + d * n + k] = std::sin(s + M_PI / 2.0);  // then all "cosines"
     }
   }
@@ -83,12 +82,11 @@ void encode_rot(const std::array<double, 3>& rot, double* o) {
   o[15] = 0.59004358992664352 * x * (-x2 + 3.0 * y2);
 }
 
-void encode_relative_geometry(const std::array<double, 3>& mic_norm,
-                              const std::array<double, 3>& src_norm,
-                              const std::array<double, 3>& rot,
+void encode_relative_geometry(const std::array<double, 3>& mic_m,
+                              const std::array<double, 3>& src_m, const std::array<double, 3>& rot,
                               const std::array<double, 3>& extent_m, double* out) {
   double d[3];
-  for (int k = 0; k < 3; ++k) d[k] = (src_norm[k] - mic_norm[k]) * extent_m[k];  // metres
+  for (int k = 0; k < 3; ++k) d[k] = src_m[k] - mic_m[k];  // metres
   const double dist = std::max(std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), 0.05);
   const double horizontal = std::sqrt(d[0] * d[0] + d[2] * d[2]);
   const double heading = std::atan2(2 * rot[2] - 1, 2 * rot[0] - 1);
@@ -101,8 +99,8 @@ void encode_relative_geometry(const std::array<double, 3>& mic_norm,
     }
   out[i++] = d[1] / dist;
   out[i++] = horizontal / dist;
-  const double diagonal = std::sqrt(extent_m[0] * extent_m[0] + extent_m[1] * extent_m[1] +
-                                    extent_m[2] * extent_m[2]);
+  const double diagonal =
+      std::sqrt(extent_m[0] * extent_m[0] + extent_m[1] * extent_m[1] + extent_m[2] * extent_m[2]);
   const double relative_dist = dist / diagonal;
   out[i++] = relative_dist;
   out[i++] = std::log(dist);

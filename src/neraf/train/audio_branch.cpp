@@ -129,10 +129,10 @@ LossDict AudioBranch::losses(StepContext& ctx) {
     batch_ = torch::empty({rir.size(0), rirs_.channels, rirs_.n_freq}, torch::kFloat32);
   rirs_.gather_into(rir, frame, batch_);
   const torch::Tensor gt = batch_.to(device_);  // [B + D·T, C, F]
-  const torch::Tensor mic =
-      data::normalize_position(rirs_.mic_positions.index_select(0, rir), rirs_.audio_aabb);
-  const torch::Tensor src =
-      data::normalize_position(rirs_.source_positions.index_select(0, rir), rirs_.audio_aabb);
+  // Metres: the model normalises them by the audio box for the position encodings and takes the
+  // relative geometry from the metres themselves (nacf_input).
+  const torch::Tensor mic = rirs_.mic_positions.index_select(0, rir);
+  const torch::Tensor src = rirs_.source_positions.index_select(0, rir);
   const torch::Tensor rot = rirs_.rots.index_select(0, rir);
   const torch::Tensor pred = model_->forward(grid_->grid(), frame.to(device_), mic.to(device_),
                                              src.to(device_), rot.to(device_));  // [B + D·T, C, F]
