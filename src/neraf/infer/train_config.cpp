@@ -33,9 +33,11 @@ Modality parse_modality(const std::string& s) { return parse_enum(Modality{}, s,
 bool published_sizes(const std::string& name) { return name == "paper" || name == "reference"; }
 
 TrainConfig train_preset(const std::string& name) {
+  require(name == "cpu" || published_sizes(name),
+          "--preset: unknown preset '" + name + "'; use cpu, paper or reference");
   TrainConfig c;
   // The radiance field of reference is paper's (the Nerfacto configuration NeRAF trains).
-  c.model = nerf::model_preset(name == "reference" ? "paper" : name);  // validates the name
+  c.model = nerf::model_preset(name == "reference" ? "paper" : name);
   c.preset = name;
   if (published_sizes(name)) {
     c.steps = 30000;  // nerfstudio's nerfacto; NeRAF runs 400k joint steps
