@@ -162,8 +162,13 @@ ExportReport export_model(const AudioRun& run, const std::string& path,
   const torch::Tensor size = torch::tensor(
       {box.max.x - box.min.x, box.max.y - box.min.y, box.max.z - box.min.z}, torch::kFloat64);
   const torch::Tensor mic = lo + u.narrow(1, 0, 3) * size;  // [N, 3]
-  const torch::Tensor src = lo + u.narrow(1, 3, 3) * size;  // [N, 3]
-  const torch::Tensor yaw = u.select(1, 6) * 360.0;         // [N]
+  // Sources: the first half over the box, the second over the box grown by half its size on each
+  // side, so most of those lie outside it (as RAF loudspeakers often do), where both paths must
+  // still agree (zero position encoding, relative geometry from the metres).
+  const torch::Tensor grown = (torch::arange(check_poses) >= check_poses / 2).to(torch::kFloat64);
+  const torch::Tensor spread = (1.0 + grown).unsqueeze(1);  // [N, 1]: 1 inside, 2 grown
+  const torch::Tensor src = lo + (u.narrow(1, 3, 3) * spread - (spread - 1.0) / 2.0) * size;
+  const torch::Tensor yaw = u.select(1, 6) * 360.0;  // [N]
   const torch::Tensor ours = model.predict_log_stft_batch(mic, src, yaw);
   const torch::Tensor reference = run.predict_log_stft_batch(mic, src, yaw);
   report.max_abs_difference = (ours - reference).abs().max().item<double>();

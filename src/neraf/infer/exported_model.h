@@ -35,7 +35,8 @@ struct ExportReport {
 };
 
 // Writes MODEL.nrf atomically, then loads it back through neraf_rt and compares its predictions
-// with `run`'s (float32) at `check_poses` poses spread over the training box; neraf::Error (and
+// with `run`'s (float32) at `check_poses` poses spread over the training box (half of them with
+// the source over the box grown by half its size on each side, mostly outside); neraf::Error (and
 // no file) when they differ by more than 1e-3 (fp32) or 0.25 (bf16) in log-magnitude.
 ExportReport export_model(const AudioRun& run, const std::string& path,
                           const ExportOptions& options = {}, int64_t check_poses = 8);
