@@ -255,7 +255,8 @@ std::string format_report(const DatasetReport& r) {
     o << "source box   " << fmt_box(r.source_box) << "\n";
     o << "audio aabb   " << fmt_box(r.audio_aabb) << " (train mics ± 1 m)\n";
     if (r.test_mics_outside || r.sources_outside)
-      o << "             outside it (normalised to 0, as the reference does): "
+      o << "             outside it (position encoded as 0, as the reference does; the "
+           "relative geometry of preset cpu still uses their metres): "
         << r.test_mics_outside << " test mics, " << r.sources_outside << " sources\n";
     if (r.t60_rirs > 0) {
       o << "T60          " << fmt_stats(r.t60_s, "s")
