@@ -45,6 +45,8 @@ struct TrainArgs {
   std::string cache_precision = "fp32";
   CLI::Option* cache_dir_opt = nullptr;
   CLI::Option* cache_precision_opt = nullptr;
+  int64_t max_len = 0;
+  CLI::Option* max_len_opt = nullptr;
   int keep = 3;
   int64_t save_every = 0;
 };
@@ -178,6 +180,12 @@ void register_train(CLI::App& app) {
                       "features rounded to ~1e-3 relative); recorded in config.json")
           ->check(CLI::IsMember({"fp32", "fp16"}))
           ->capture_default_str();
+  args->max_len_opt =
+      cmd->add_option("--max-len", args->max_len,
+                      "SoundSpaces layout: STFT frames per RIR (default: the published value for "
+                      "office_4, room_2, apartment_1/2, frl_apartment_2/4 by the dataset folder's "
+                      "name, else the longest training RIR); recorded in config.json")
+          ->transform(whole_number(2, 100000));
   cmd->add_option("--keep", args->keep,
                   "Checkpoints to keep, the newest (0: keep all; older ones are deleted as new "
                   "ones are written)")
@@ -211,6 +219,7 @@ void register_train(CLI::App& app) {
     infer::TrainConfig cfg = infer::resolve_train_config(flags);
     cfg.audio.cache_dir = args->cache_dir;
     cfg.audio.cache_precision = args->cache_precision;
+    cfg.audio.max_len = args->max_len;
     if (!args->resume) check_batch_memory(cfg);
     if (cfg.model.precision == nerf::Precision::bf16 && !nerf::cpu_supports_bf16())
       warn("--precision bf16: this CPU has no native bf16 instructions; expect slow training");
@@ -230,7 +239,7 @@ void register_train(CLI::App& app) {
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json is "
                                      "used); start a new run with --out to change it");
-      for (CLI::Option* o : {args->cache_dir_opt, args->cache_precision_opt})
+      for (CLI::Option* o : {args->cache_dir_opt, args->cache_precision_opt, args->max_len_opt})
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json records "
                                      "it); start a new run with --out to change it");

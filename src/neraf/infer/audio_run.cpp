@@ -55,21 +55,24 @@ geometry::Vec3 vec_from(const nlohmann::json& j) {
 }  // namespace
 
 nlohmann::json make_audio_manifest(const data::RirSet& r) {
-  return {{"layout", data::to_string(r.layout)},
-          {"num_rirs", r.size()},
-          {"num_train", static_cast<int64_t>(r.train.size())},
-          {"num_test", static_cast<int64_t>(r.test.size())},
-          {"hash", dataset_hash(r)},
-          {"sample_rate", r.sample_rate},
-          {"channels", r.channels},
-          {"n_fft", r.stft.n_fft},
-          {"win_length", r.stft.win_length},
-          {"hop_length", r.stft.hop_length},
-          {"n_freq", r.n_freq},
-          {"max_len", r.max_len},
-          {"waveform_length", r.waveform_length},
-          {"aabb_min", vec_json(r.audio_aabb.min)},
-          {"aabb_max", vec_json(r.audio_aabb.max)}};
+  nlohmann::json m = {{"layout", data::to_string(r.layout)},
+                      {"num_rirs", r.size()},
+                      {"num_train", static_cast<int64_t>(r.train.size())},
+                      {"num_test", static_cast<int64_t>(r.test.size())},
+                      {"hash", dataset_hash(r)},
+                      {"sample_rate", r.sample_rate},
+                      {"channels", r.channels},
+                      {"n_fft", r.stft.n_fft},
+                      {"win_length", r.stft.win_length},
+                      {"hop_length", r.stft.hop_length},
+                      {"n_freq", r.n_freq},
+                      {"max_len", r.max_len},
+                      {"waveform_length", r.waveform_length},
+                      {"aabb_min", vec_json(r.audio_aabb.min)},
+                      {"aabb_max", vec_json(r.audio_aabb.max)}};
+  if (!r.max_len_source.empty()) m["max_len_source"] = r.max_len_source;
+  if (!r.max_len_note.empty()) m["max_len_note"] = r.max_len_note;
+  return m;
 }
 
 AudioRunInfo audio_info_from_manifest(const nlohmann::json& a, const std::string& where) {
@@ -124,11 +127,11 @@ acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, in
       acoustic::acoustic_preset(config.preset, channels, n_freq, max_len);
   const AudioConfig& a = config.audio;
   o.grid_mode = acoustic::parse_grid_mode(a.grid);
+  o.grid.view_directions = acoustic::parse_view_directions(a.view_directions);
+  o.resnet.running_stats = a.resnet_batch_norm == "running";
   o.grid.resolution = a.grid_resolution;
   o.grid.cells_per_update = a.cells_per_update;
   if (a.nacf_width > 0) o.nacf.trunk.assign(static_cast<size_t>(a.nacf_layers), a.nacf_width);
-  o.grid.view_directions = acoustic::parse_view_directions(a.view_directions);
-  o.resnet.running_stats = a.resnet_batch_norm == "running";
   // The NAcF trunk follows --precision, as the radiance field's MLPs.
   o.nacf.bf16 = config.model.precision == nerf::Precision::bf16;
   o.nacf.relative_geometry = a.relative_geometry;

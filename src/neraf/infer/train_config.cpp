@@ -199,6 +199,8 @@ void validate(const TrainConfig& c, const std::string& where) {
   require(a.early_fraction >= 0 && a.early_fraction <= 1,
           where + ".audio.early_fraction: must be in [0, 1]");
   require(a.early_frames >= 1, where + ".audio.early_frames: must be at least 1");
+  require(a.max_len == 0 || (a.max_len >= 2 && a.max_len <= 100000),
+          where + ".audio.max_len: use 0 (automatic) or 2..100000 frames (--max-len)");
   require(a.cache_precision == "fp32" || a.cache_precision == "fp16",
           where + ".audio.cache_precision: use fp32 or fp16 (--cache-precision)");
   if (c.modality == Modality::audio)

@@ -82,6 +82,9 @@ struct AudioConfig {
   // relative; --cache-precision). Recorded so resume, calibration and eval reuse the same cache.
   std::string cache_dir;
   std::string cache_precision = "fp32";
+  // SoundSpaces frames per RIR (--max-len); 0 = automatic (data::RirLoadOptions::max_len: the
+  // published value of a known scene, else the longest training RIR).
+  int64_t max_len = 0;
   // "audio_fields" group: NAcF + ResNet3D (+ the radiance field in joint mode), Adam eps 1e-15,
   // sine warm-up from 1e-8 over warmup_steps then log-linear decay (neraf-reference.md §2.3).
   ScheduleConfig schedule{1e-4, 1e-8, 1002000, 2000, 1e-8, "sine", 1e-15};
@@ -103,11 +106,12 @@ struct AudioConfig {
     v("energy_calibration", energy_calibration);
     v("relative_geometry", relative_geometry);
     v("position_max_freq_exp", position_max_freq_exp);
+    v("view_directions", view_directions);
+    v("resnet_batch_norm", resnet_batch_norm);
     v("vision_run", vision_run);
     v("cache_dir", cache_dir);
     v("cache_precision", cache_precision);
-    v("view_directions", view_directions);
-    v("resnet_batch_norm", resnet_batch_norm);
+    v("max_len", max_len);
     v("schedule", schedule);
   }
 };
@@ -156,13 +160,13 @@ void set_run_length(TrainConfig& c, int64_t steps);
 //   cpu        sized for 2 CPU cores, with our additions (docs/ARCHITECTURE.md)
 TrainConfig train_preset(const std::string& name);
 
+// Whether `name` uses the published sizes and run lengths (paper, reference).
+bool published_sizes(const std::string& name);
+
 // What `neraf train` was asked for; an unset optional takes the preset's value for the modality.
 struct TrainFlags {
   std::string preset = "cpu";                // --preset
   Modality modality = Modality::joint;       // --modality
-// Whether `name` uses the published sizes and run lengths (paper, reference).
-bool published_sizes(const std::string& name);
-
   std::optional<int64_t> steps;              // --steps
   uint64_t seed = 42;                        // --seed
   std::optional<int> threads;                // --threads
