@@ -17,6 +17,7 @@
 #include "neraf/cli/commands.h"
 #include "neraf/cli/flag_checks.h"
 #include "neraf/data/image_set.h"
+#include "neraf/data/layout.h"
 #include "neraf/eval/audio_eval.h"
 #include "neraf/eval/evaluation.h"
 #include "neraf/infer/audio_run.h"
@@ -196,8 +197,12 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
   // Checked before anything is scored or written.
   std::optional<data::RirSet> novel;
   if (!args.novel_data.empty()) {
-    // Cut or padded to the run's frames, whatever the set's own automatic value would be.
-    novel = load_rirs(args.novel_data, !args.quiet, cache, rirs.max_len);
+    // Cut or padded to the run's frames, whatever the set's own automatic value would be (a set
+    // of the other layout loads as it is, for the format check below to name what differs).
+    const data::DatasetLayout layout = data::detect_layout(args.novel_data);
+    const bool same_layout =
+        rirs.layout == data::AudioLayout::soundspaces ? layout.soundspaces : layout.raf;
+    novel = load_rirs(args.novel_data, !args.quiet, cache, same_layout ? rirs.max_len : 0);
     infer::check_same_room_format(source.manifest.at("audio"), *novel, args.novel_data);
     check_same_gain(data_dir, args.novel_data);
   }
