@@ -16,10 +16,11 @@ neraf=build/neraf
 work=$(mktemp -d "${TMPDIR:-/tmp}/neraf_synth_bench.XXXXXX")
 trap 'rm -rf "$work"' EXIT
 
+commit=$(git rev-parse --short HEAD)  # the build measured is of the working tree at this commit
 rows=()
 for p in "${presets[@]}"; do
   load_before=$(cut -d' ' -f1-3 /proc/loadavg)
-  dry=$("$neraf" synth --preset "$p" --dry-run | tr '\n' ' ')
+  dry=$("$neraf" synth --preset "$p" --dry-run | tr '\n' ' ' | sed 's/"/\\"/g')
   /usr/bin/time -f "%e %M" -o "$work/time" "$neraf" synth --preset "$p" --out "$work/ds" --quiet \
     --threads "$threads" >"$work/summary" 2>&1
   read -r wall rss_kb <"$work/time"
@@ -35,7 +36,7 @@ done
 {
   echo "{\"generator\": \"bench/synth_presets.sh\", \"date\": \"$(date -u +%FT%TZ)\","
   echo " \"machine\": \"$(lscpu | sed -n 's/^Model name: *//p' | head -1), $(nproc) cores, $(free -g | awk '/Mem:/{print $2}') GB\","
-  echo " \"commit\": \"$(git rev-parse --short HEAD)\", \"threads\": $threads,"
+  echo " \"commit\": \"$commit\", \"threads\": $threads,"
   echo " \"note\": \"load_before/after: /proc/loadavg (1, 5, 15 min); other engineers share the 2 cores\","
   echo " \"presets\": ["
   for i in "${!rows[@]}"; do

@@ -177,19 +177,19 @@ void register_synth(CLI::App& app) {
   cmd->add_flag("--print-scene", args->print_scene,
                 "Print the resolved scene JSON (e.g. of a preset, to edit and pass back with "
                 "--scene) and exit");
-  CLI::Option* plan_only = cmd->add_option(
-      "--plan-only", args->plan_only,
-      "Draw the top-down plan of the scene (walls, furniture, microphones, sources, cameras; as "
-      "the dataset's plan.png) into this PNG file and exit without synthesising");
-  CLI::Option* dry_run = cmd->add_flag(
-      "--dry-run", args->dry_run,
-      "Print how many RIRs and images the scene gives in this layout and exit (writes "
-      "nothing)");
-  plan_only->excludes(dry_run);
+  cmd->add_option("--plan-only", args->plan_only,
+                  "Draw the top-down plan of the scene (walls, furniture, microphones, sources, "
+                  "cameras; as the dataset's plan.png) into this PNG file and exit without "
+                  "synthesising");
+  cmd->add_flag("--dry-run", args->dry_run,
+                "Print how many RIRs and images the scene gives in this layout (and how many "
+                "direct paths furniture or walls block) and exit (writes nothing)");
   cmd->callback([args] {
     require(args->plan_only.empty() || args->out_dir.empty(),
             "--plan-only: draws the plan without synthesising; drop --out (a synthesised "
             "dataset gets its plan as DIR/plan.png)");
+    require(args->plan_only.empty() || !(args->dry_run || args->print_scene),
+            "--plan-only: give it alone, without --dry-run or --print-scene");
     run_synth(*args);
   });
 }
