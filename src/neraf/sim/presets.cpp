@@ -265,7 +265,7 @@ Scene raf_room(bool furnished) {
   s.size = {6.0, 2.8, 5.0};
   s.materials["floor"] = material({0.50, 0.36, 0.24}, "stripes", 0.25, 0.25, kWoodFloor, 0.1);
   // Absorbing ceiling tiles (an office-like room): the empty room's decay stays well inside the
-  // RIR (Eyring T60 ≈ 0.6 s at 1 kHz, furnished ≈ 0.45 s; docs/SCENE_FORMAT.md).
+  // RIR (Eyring T60 ≈ 0.5 s at 1 kHz, furnished ≈ 0.35 s; docs/SCENE_FORMAT.md).
   s.materials["ceiling"] = material({0.90, 0.90, 0.88}, "checker", 0.6, 0.1, kAcousticCeiling, 0.2);
   s.materials["wall"] = material({0.80, 0.76, 0.68}, "noise", 0.25, 0.25, kPaintedPlaster, 0.1);
   s.materials["window"] = material({0.55, 0.65, 0.75}, "stripes", 0.6, 0.2, kGlass, 0.05);
@@ -308,8 +308,9 @@ Scene raf_room(bool furnished) {
   return s;
 }
 
-// A small, heavily treated room (carpet, absorbing panels, curtains): short decay, strong direct
-// sound. With large_live and demo, three rooms of different size and absorption.
+// A small, heavily treated room (carpet, an absorbing ceiling, a curtain wall, a sofa): short decay
+// (Eyring T60 ≈ 0.1 s at 1 kHz), strong direct sound. With large_live and demo, three rooms of
+// different size and absorption.
 Scene small_dead() {
   Scene s;
   s.name = "small_dead";
@@ -344,7 +345,8 @@ Scene small_dead() {
   return s;
 }
 
-// A large hall with hard surfaces (concrete, glass, tiles): long decay, late energy dominates.
+// A large hall with hard surfaces (wood floor, plaster, a glass wall) and a block of upholstered
+// seats: long decay (Eyring T60 ≈ 1.3 s at 1 kHz), late energy dominates.
 Scene large_live() {
   Scene s;
   s.name = "large_live";
