@@ -1,5 +1,6 @@
 // Audio evaluation: baseline neighbour selection, the eval JSON/CSV/PNG outputs of a run folder,
-// and the paired differences against each baseline.
+// the uncalibrated row of a calibrated run, the paired differences against each baseline, and the
+// check that an ablation trained like the run it is compared with.
 #include "neraf/eval/audio_eval.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 
 #include "../infer/audio_test_util.h"
 #include "neraf/infer/audio_run.h"
+#include "neraf/infer/calibration.h"
 #include "neraf/infer/checkpoint.h"
 #include "neraf/io/json_file.h"
 #include "neraf/train/trainer.h"
@@ -126,6 +128,116 @@ TEST(AudioEval, RunFolderPredictsAndWritesJsonCsvPng) {
   } catch (const Error& err) {
     EXPECT_NE(std::string(err.what()).find("sample_rate"), std::string::npos) << err.what();
   }
+}
+
+// A calibrated run is scored twice: "neraf" with its calibration and "neraf_uncalibrated", which
+// is exactly the run evaluated with its calibration removed (same RIRs, same Griffin-Lim seeds).
+TEST(AudioEval, UncalibratedRowIsTheRunWithoutItsCalibration) {
+  torch::manual_seed(0);
+  const std::string dir = make_temp_dir("eval_uncal");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  const data::ImageSet images = make_image_set();
+  TrainConfig c = tiny_joint_config();
+  ASSERT_TRUE(c.audio.energy_calibration);
+  auto trainer = train::make_trainer(c, &images, torch::kCPU, &rirs);
+  trainer->step();
+  trainer->step();
+  const std::string run = dir + "/run";
+  trainer->save_checkpoint(infer::checkpoint_path(run, 2));
+  io::write_json_atomically(run + "/config.json", infer::to_json(c));
+  io::write_json_atomically(run + "/data.json", {{"audio", infer::make_audio_manifest(rirs)}});
+  infer::calibrate_run(run, rirs);
+
+  const AudioRun calibrated = infer::load_audio_run(run);
+  ASSERT_TRUE(calibrated.calibration().defined());
+  const AudioRun uncalibrated = infer::load_audio_run(run, torch::kCPU, "", nerf::Precision::fp32,
+                                                      /*calibrated=*/false);
+  ASSERT_FALSE(uncalibrated.calibration().defined());
+
+  AudioEvalOptions o;
+  o.progress = false;
+  o.seed = 7;
+  o.neraf_post_processing = kCalibratedGriffinLim;
+  o.uncalibrated = &uncalibrated;
+  const AudioEval e = evaluate_audio(calibrated, rirs, rirs.train, o);
+  ASSERT_EQ(e.methods.size(), 4u);
+  EXPECT_EQ(e.methods[0].name, "neraf");
+  EXPECT_EQ(e.methods[0].post_processing, kCalibratedGriffinLim);
+  EXPECT_EQ(e.methods[1].name, kUncalibratedName);
+  EXPECT_EQ(e.methods[1].post_processing, kGriffinLim);
+  EXPECT_EQ(e.methods[2].post_processing, kMeasuredWaveform);  // nearest
+  EXPECT_EQ(e.methods[3].post_processing, kGriffinLim);        // linear
+
+  // The reference: the run loaded without its calibration, scored as the only model.
+  const AudioMethodEval alone = evaluate_audio_model(uncalibrated, rirs, rirs.test, "neraf", o);
+  ASSERT_EQ(alone.per_rir.size(), e.methods[1].per_rir.size());
+  bool calibration_changed_something = false;
+  for (size_t n = 0; n < alone.per_rir.size(); ++n) {
+    const auto &a = alone.per_rir[n], &u = e.methods[1].per_rir[n], &k = e.methods[0].per_rir[n];
+    EXPECT_EQ(a.c50_error_db, u.c50_error_db) << n;
+    EXPECT_EQ(a.stft_error, u.stft_error) << n;
+    EXPECT_EQ(a.c50_pred_db, u.c50_pred_db) << n;
+    if (a.stft_error != k.stft_error || a.c50_pred_db != k.c50_pred_db)
+      calibration_changed_something = true;
+  }
+  EXPECT_TRUE(calibration_changed_something) << "the calibrated row equals the uncalibrated one";
+
+  const nlohmann::json j = to_json(e);
+  EXPECT_EQ(j["neraf"]["post_processing"], kCalibratedGriffinLim);
+  EXPECT_EQ(j[kUncalibratedName]["post_processing"], kGriffinLim);
+  EXPECT_EQ(j["nearest"]["post_processing"], kMeasuredWaveform);
+  const nlohmann::json pu = paired_to_json(e, kUncalibratedName);
+  ASSERT_TRUE(pu.contains("linear"));
+  EXPECT_EQ(pu["linear"]["c50_error_db"]["n"], 2);
+  EXPECT_NE(audio_table(e.methods).find(kCalibratedGriffinLim), std::string::npos);
+  EXPECT_NE(paired_table(e, kUncalibratedName).find(kUncalibratedName), std::string::npos);
+}
+
+// An ablation may differ from the run it is compared with only in the ablation knobs.
+TEST(AudioEval, TrainingDifferenceAllowsOnlyTheAblationKnobs) {
+  const TrainConfig main = tiny_joint_config();
+  const nlohmann::json main_data = {{"data", "runs/scene"}, {"audio", {{"hash", "abc"}}}};
+  const nlohmann::json mj = infer::to_json(main);
+  EXPECT_EQ(training_difference(mj, main_data, mj, main_data), "");
+
+  TrainConfig knobs = main;  // the ablated options and what does not change what is trained
+  knobs.audio.grid = "zeros";
+  knobs.audio.grid_resolution = 16;
+  knobs.audio.relative_geometry = false;
+  knobs.threads = 3;
+  knobs.save_every = 7;
+  knobs.audio.cache_dir = "/elsewhere";
+  nlohmann::json moved = main_data;
+  moved["data"] = "/abs/runs/scene";  // the same dataset named another way
+  EXPECT_EQ(training_difference(mj, main_data, infer::to_json(knobs), moved), "");
+
+  auto differs = [&](const TrainConfig& other, const std::string& key) {
+    const std::string d = training_difference(mj, main_data, infer::to_json(other), main_data);
+    EXPECT_NE(d.find(key), std::string::npos) << "expected " << key << " in '" << d << "'";
+  };
+  TrainConfig audio_only = main;
+  audio_only.modality = infer::Modality::audio;
+  differs(audio_only, "config.json modality: \"audio\" vs \"joint\"");
+  TrainConfig longer = main;
+  longer.steps = main.steps + 1;
+  differs(longer, "config.json steps");
+  TrainConfig schedule = main;
+  schedule.audio.schedule.max_steps = 5;
+  differs(schedule, "config.json audio.schedule.max_steps");
+  TrainConfig seed = main;
+  seed.seed = main.seed + 1;
+  differs(seed, "config.json seed");
+  TrainConfig preset = main;
+  preset.preset = "paper";
+  differs(preset, "config.json preset");
+  TrainConfig frozen = main;
+  frozen.audio.vision_run = "/some/other/run";
+  differs(frozen, "audio.vision_run");
+
+  nlohmann::json other_data = main_data;
+  other_data["audio"]["hash"] = "def";
+  EXPECT_NE(training_difference(mj, main_data, mj, other_data).find("data.json audio.hash"),
+            std::string::npos);
 }
 
 // Paired neraf − baseline differences on hand-made per-RIR errors.

@@ -83,10 +83,21 @@ struct AudioEvalSet {
   std::vector<int64_t> test;
 };
 
+// The post-processing of a field's predictions (eval::AudioMethodEval::post_processing).
+const char* post_processing_of(const infer::AudioRun& run) {
+  return run.calibration().defined() ? eval::kCalibratedGriffinLim : eval::kGriffinLim;
+}
+
+// An ablation run and its label in the table and JSON (its folder's name).
+struct Ablation {
+  std::string dir, label;
+  infer::AudioRun run;
+};
+
 // The run, its baselines and the ablation runs on one set; prints the table under `title`, writes
-// the per-RIR CSV into opts.out_dir as `csv_name` → {"neraf", "nearest", "linear", "ablations"}.
-nlohmann::json score_audio(const infer::AudioField& run,
-                           const std::vector<std::pair<std::string, infer::AudioRun>>& ablations,
+// the per-RIR CSV into opts.out_dir as `csv_name` → {"neraf", "neraf_uncalibrated", "nearest",
+// "linear", "paired", "paired_uncalibrated", "ablations", "paired_ablations"}.
+nlohmann::json score_audio(const infer::AudioField& run, const std::vector<Ablation>& ablations,
                            const AudioEvalSet& set, const eval::AudioEvalOptions& opts,
                            const std::string& csv_name, const std::string& title,
                            const OutputDir& dir) {
@@ -95,27 +106,41 @@ nlohmann::json score_audio(const infer::AudioField& run,
   nlohmann::json out = eval::to_json(e);
   const nlohmann::json paired = eval::paired_to_json(e);
   if (!paired.empty()) out["paired"] = paired;
+  const nlohmann::json paired_uncalibrated = eval::paired_to_json(e, eval::kUncalibratedName);
+  if (!paired_uncalibrated.empty()) out["paired_uncalibrated"] = paired_uncalibrated;
+  std::vector<std::string> labels;
   if (!ablations.empty()) {
     nlohmann::json abl = nlohmann::json::object();
     eval::AudioEvalOptions o = opts;
     o.num_images = 0;
-    for (const auto& [dir, other] : ablations) {
-      const std::string label = std::filesystem::path(dir).filename().string();
-      eval::AudioMethodEval m = eval::evaluate_audio_model(other, set.test_set, set.test, label, o);
-      abl[label] = eval::to_json(m.summary);
-      abl[label]["run"] = dir;
-      abl[label]["grid"] = other.run().config.audio.grid;
-      abl[label]["relative_geometry"] = other.run().config.audio.relative_geometry;
+    for (const Ablation& a : ablations) {
+      eval::AudioMethodEval m = eval::evaluate_audio_model(a.run, set.test_set, set.test, a.label,
+                                                           o, post_processing_of(a.run));
+      abl[a.label] = eval::to_json(m.summary);
+      abl[a.label]["run"] = a.dir;
+      abl[a.label]["grid"] = a.run.run().config.audio.grid;
+      abl[a.label]["grid_resolution"] = a.run.run().config.audio.grid_resolution;
+      abl[a.label]["relative_geometry"] = a.run.run().config.audio.relative_geometry;
+      abl[a.label]["post_processing"] = m.post_processing;
+      labels.push_back(a.label);
       e.methods.push_back(std::move(m));
     }
     out["ablations"] = abl;
+    out["paired_ablations"] = eval::paired_to_json(e, "neraf", labels);
   }
   eval::write_audio_csv((std::filesystem::path(dir.written) / csv_name).string(), e);
   const std::string csv = (std::filesystem::path(dir.shown) / csv_name).string();
   out["per_rir_csv"] = csv;
-  std::printf("%s (%s, %zu RIRs, %.1f s; per-RIR CSV %s):\n%s%s", title.c_str(),
-              data::to_string(set.test_set.layout), e.rir_ids.size(), e.seconds, csv.c_str(),
-              eval::audio_table(e.methods).c_str(), eval::paired_table(e).c_str());
+  std::printf(
+      "%s (%s, %zu RIRs, %.1f s; per-RIR CSV %s):\n%s"
+      "post-processing: %s = Griffin-Lim of the prediction with the run's energy calibration and "
+      "early/late balance, fitted on its training RIRs; %s = Griffin-Lim of the magnitudes as "
+      "predicted or blended; %s = a training RIR as measured\n%s%s%s",
+      title.c_str(), data::to_string(set.test_set.layout), e.rir_ids.size(), e.seconds, csv.c_str(),
+      eval::audio_table(e.methods).c_str(), eval::kCalibratedGriffinLim, eval::kGriffinLim,
+      eval::kMeasuredWaveform, eval::paired_table(e).c_str(),
+      eval::paired_table(e, eval::kUncalibratedName).c_str(),
+      eval::paired_table(e, "neraf", labels).c_str());
   return out;
 }
 
@@ -157,7 +182,41 @@ struct EvalField {
   double audio_fraction = 1;
   std::string grid;
   CacheChoice cache;  // the run's feature cache (before the flags)
+  // What the field's predictions carry (eval::kCalibratedGriffinLim or kGriffinLim) and, for a
+  // calibrated run, the same field loaded without its calibration (else nullptr).
+  std::string post_processing = eval::kGriffinLim;
+  const infer::AudioField* uncalibrated = nullptr;
+  // --run only (nullptr for --model): the run, which the ablation runs must have trained like.
+  const infer::AudioRun* run = nullptr;
 };
+
+// Refuses an ablation run whose training differs from the main run's in anything but the
+// ablation knobs (eval::training_difference), whose checkpoint is at another step, or which
+// lacks the calibration the main run has: its numbers would not measure the ablated option.
+void check_trained_alike(const infer::AudioRun& main, const std::string& main_dir,
+                         const infer::AudioRun& other, const std::string& dir) {
+  std::string knobs;
+  for (const std::string& k : eval::ablation_knobs()) knobs += (knobs.empty() ? "" : ", ") + k;
+  const std::string difference =
+      eval::training_difference(infer::to_json(main.run().config), main.run().manifest,
+                                infer::to_json(other.run().config), other.run().manifest);
+  require(difference.empty(), "--ablation-runs: " + dir + " was not trained like --run " +
+                                  main_dir + " (" + difference +
+                                  "); an ablation may differ only in " + knobs +
+                                  ": retrain it with --run's settings and only the ablated flag");
+  require(other.step() == main.step(),
+          "--ablation-runs: " + dir + " is at step " + std::to_string(other.step()) + ", --run " +
+              main_dir + " at step " + std::to_string(main.step()) +
+              "; finish its training (neraf train --out " + dir +
+              " --resume) or pick --run's --checkpoint at the same step");
+  // Both have the same audio.energy_calibration (compared above); one may not be calibrated yet.
+  const bool main_calibrated = main.calibration().defined();
+  require(other.calibration().defined() == main_calibrated,
+          "--ablation-runs: " + (main_calibrated ? dir : "--run " + main_dir) +
+              " has no calibration for its checkpoint and " +
+              (main_calibrated ? "--run " + main_dir : dir) + " has; run: neraf calibrate --run " +
+              (main_calibrated ? dir : main_dir));
+}
 
 // The acoustic field on the test RIRs (and, with --novel-data, on every RIR of another dataset of
 // the same room), with the nearest/linear baselines and the ablation runs.
@@ -172,22 +231,30 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
   // The run's data as training loaded it (same options, same cache file).
   const data::RirSet rirs = load_rirs(data_dir, !args.quiet, cache, cache.max_len);
   infer::check_audio_manifest(source.manifest.at("audio"), rirs, data_dir);
-  std::vector<std::pair<std::string, infer::AudioRun>> ablations;
+  std::vector<Ablation> ablations;
   std::set<std::string> labels;  // the table's and the JSON's name of each: its folder's name
+  require(args.ablation_runs.empty() || source.run,
+          "--ablation-runs: needs --run (an exported --model does not record how it was trained, "
+          "so the ablations cannot be checked against it)");
   for (const std::string& dir : split_commas(args.ablation_runs)) {
     const std::string label = std::filesystem::path(dir).lexically_normal().filename().string();
-    require(labels.insert(label).second,
-            "--ablation-runs: two runs are called '" + label +
+    require(labels.insert(label).second && label != "neraf" && label != eval::kUncalibratedName &&
+                label != "nearest" && label != "linear",
+            "--ablation-runs: two runs (or a run and a method) are called '" + label +
                 "' (each is labelled by its folder's name); give each its own folder name");
-    ablations.emplace_back(
-        dir, infer::load_audio_run(dir, torch::kCPU, "", nerf::parse_precision(args.precision)));
-    infer::check_audio_manifest(ablations.back().second.run().manifest.at("audio"), rirs,
+    ablations.push_back(
+        {dir, label,
+         infer::load_audio_run(dir, torch::kCPU, "", nerf::parse_precision(args.precision))});
+    infer::check_audio_manifest(ablations.back().run.run().manifest.at("audio"), rirs,
                                 dir + "/data.json");
+    check_trained_alike(*source.run, args.run, ablations.back().run, dir);
   }
   eval::AudioEvalOptions opts;
   opts.progress = !args.quiet;
   opts.baselines = !args.no_baselines;
   opts.seed = source.seed;
+  opts.neraf_post_processing = source.post_processing;
+  opts.uncalibrated = source.uncalibrated;
   opts.out_dir = dir.written;
   if (args.no_images) opts.num_images = 0;
   const std::vector<int64_t> subset =
@@ -262,11 +329,17 @@ void register_eval(CLI::App& app) {
   cmd->footer(
       "PSNR and SSIM follow nerfstudio's evaluation (torchmetrics semantics, mean over the\n"
       "eval views). The JSON has {\"run\", \"checkpoint\", \"step\", \"vision\": {\"psnr\",\n"
-      "\"ssim\", \"n_views\", \"views\": [...]}, \"audio\": {\"neraf\"|\"nearest\"|\"linear\":\n"
-      "{\"t60_error_pct\", \"c50_error_db\", \"edt_error_s\", \"stft_error\", \"invalid_t60\",\n"
-      "\"n_rirs\", \"*_std\"}, \"ablations\", \"novel\"}}. Audio follows NeRAF's\n"
-      "evaluator: predicted log-STFT → Griffin-Lim (32 it., seeded) → T60/C50/EDT vs the\n"
-      "measured waveform. Baselines:\n"
+      "\"ssim\", \"n_views\", \"views\": [...]}, \"audio\": {\"neraf\"|\"neraf_uncalibrated\"|\n"
+      "\"nearest\"|\"linear\": {\"t60_error_pct\", \"c50_error_db\", \"edt_error_s\",\n"
+      "\"stft_error\", \"invalid_t60\", \"n_rirs\", \"*_std\", \"post_processing\"}, \"paired\",\n"
+      "\"paired_uncalibrated\", \"ablations\", \"paired_ablations\", \"novel\"}}. Audio follows\n"
+      "NeRAF's evaluator: predicted log-STFT → Griffin-Lim (32 it., seeded) → T60/C50/EDT vs\n"
+      "the measured waveform. A calibrated run (the cpu preset) is scored twice: \"neraf\" with\n"
+      "the energy calibration and early/late balance fitted on its training RIRs, and\n"
+      "\"neraf_uncalibrated\" without, as the linear baseline is rendered (each row states its\n"
+      "post-processing). --ablation-runs must have trained exactly as --run but for audio.grid,\n"
+      "audio.grid_resolution or audio.relative_geometry (same modality, preset, steps, seed,\n"
+      "data; else refused). Baselines:\n"
       "nearest = the measured RIR of the closest training mic with the same heading and source;\n"
       "linear = inverse-distance blend of the 2-4 closest such training RIRs' magnitudes +\n"
       "Griffin-Lim. Side-by-side GT | prediction PNGs (images: eval_*.png; audio: audio_*.png\n"
@@ -315,9 +388,11 @@ void register_eval(CLI::App& app) {
                   "RUN/config.json; fp32 with --model)")
       ->check(CLI::IsMember({"fp32", "fp16"}));
   cmd->add_option("--ablation-runs", args->ablation_runs,
-                  "Audio: comma-separated run folders of the same dataset (e.g. trained with "
-                  "--grid none / zeros) scored on the same test RIRs and added to the table "
-                  "and JSON (audio.ablations, labelled by folder name)");
+                  "Audio: comma-separated run folders trained exactly as --run but for the "
+                  "ablated option (--grid none / zeros, --no-relative-geometry; same modality, "
+                  "preset, steps, seed and data, else refused), scored on the same test RIRs and "
+                  "added to the table and JSON (audio.ablations, labelled by folder name, and "
+                  "audio.paired_ablations: --run − each)");
   cmd->add_option("--novel-data", args->novel_data,
                   "Audio: another dataset of the same room (same layout and rates, e.g. "
                   "`neraf synth --preset demo --mics random`): every RIR of it is scored as well, "
@@ -332,12 +407,15 @@ void register_eval(CLI::App& app) {
       const nlohmann::json& meta = model.metadata();
       require(meta.contains("data") && meta["data"].contains("audio"),
               args->model + ": records no training data manifest; re-export it with neraf export");
-      EvalField source{model,
-                       meta["data"],
-                       meta.value("seed", uint64_t{0}),
-                       meta.value("audio_fraction", 1.0),
-                       meta.value("grid", std::string("sampled")),
-                       {}};
+      // The file holds its calibration folded in: scored as exported (no uncalibrated row).
+      EvalField source{
+          model,
+          meta["data"],
+          meta.value("seed", uint64_t{0}),
+          meta.value("audio_fraction", 1.0),
+          meta.value("grid", std::string("sampled")),
+          {},
+          meta.value("calibration", false) ? eval::kCalibratedGriffinLim : eval::kGriffinLim};
       nlohmann::json out = {{"model", args->model},
                             {"run", meta.value("run", std::string())},
                             {"checkpoint", meta.value("checkpoint", std::string())},
@@ -374,6 +452,13 @@ void register_eval(CLI::App& app) {
             out["checkpoint"] = audio.run().checkpoint;
             out["step"] = audio.step();
             out["precision"] = args->precision;
+            // A calibrated run is also scored without its calibration (the linear baseline
+            // renders through the same Griffin-Lim with none).
+            std::optional<infer::AudioRun> uncalibrated;
+            if (audio.calibration().defined())
+              uncalibrated = infer::load_audio_run(args->run, torch::kCPU, args->checkpoint,
+                                                   nerf::parse_precision(args->precision),
+                                                   /*calibrated=*/false);
             const EvalField source{
                 audio,
                 audio.run().manifest,
@@ -381,7 +466,10 @@ void register_eval(CLI::App& app) {
                 audio.run().config.audio.fraction,
                 audio.run().config.audio.grid,
                 {audio.run().config.audio.cache_dir, audio.run().config.audio.cache_precision,
-                 audio.run().config.audio.max_len}};
+                 audio.run().config.audio.max_len},
+                post_processing_of(audio),
+                uncalibrated ? &*uncalibrated : nullptr,
+                &audio};
             out["audio"] = evaluate_audio_json(source, *args, dir);
           }
           if (!args->skip_vision) {

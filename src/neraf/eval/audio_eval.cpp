@@ -10,8 +10,10 @@
 #include <exception>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <numeric>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -140,10 +142,12 @@ std::vector<int64_t> nearest_training_rirs(const data::RirSet& train_set,
 
 AudioMethodEval evaluate_audio_model(const infer::AudioField& run, const data::RirSet& rirs,
                                      const std::vector<int64_t>& test, const std::string& label,
-                                     const AudioEvalOptions& options) {
+                                     const AudioEvalOptions& options,
+                                     const std::string& post_processing) {
   const auto t0 = std::chrono::steady_clock::now();
   AudioMethodEval m;
   m.name = label;
+  m.post_processing = post_processing;
   m.per_rir.resize(test.size());
   const metrics::Variant variant = variant_of(rirs);
   Progress progress("eval audio (" + label + ")", static_cast<int64_t>(test.size()),
@@ -187,13 +191,18 @@ AudioEval evaluate_audio(const infer::AudioField& run, const data::RirSet& train
   AudioEval e;
   for (int64_t i : test) e.rir_ids.push_back(test_set.rirs[static_cast<size_t>(i)].id);
   if (!options.out_dir.empty()) fs::create_directories(options.out_dir);
-  e.methods.push_back(evaluate_audio_model(run, test_set, test, "neraf", options));
+  e.methods.push_back(
+      evaluate_audio_model(run, test_set, test, "neraf", options, options.neraf_post_processing));
+  if (options.uncalibrated)  // same seeds, same RIRs: only the calibration differs
+    e.methods.push_back(evaluate_audio_model(*options.uncalibrated, test_set, test,
+                                             kUncalibratedName, options, kGriffinLim));
 
   if (options.baselines) {
     require(!train_subset.empty(), "baselines: no training RIRs");
     const metrics::Variant variant = variant_of(test_set);
     const auto t_baselines = std::chrono::steady_clock::now();
-    AudioMethodEval nearest{"nearest", {}, {}, 0}, linear{"linear", {}, {}, 0};
+    AudioMethodEval nearest{"nearest", {}, {}, 0, kMeasuredWaveform},
+        linear{"linear", {}, {}, 0, kGriffinLim};
     nearest.per_rir.resize(test.size());
     linear.per_rir.resize(test.size());
     Progress progress("eval audio (baselines)", static_cast<int64_t>(test.size()),
@@ -261,6 +270,7 @@ nlohmann::json to_json(const AudioEval& e) {
   for (const auto& m : e.methods) {
     j[m.name] = to_json(m.summary);
     j[m.name]["seconds"] = m.seconds;
+    j[m.name]["post_processing"] = m.post_processing;
   }
   return j;
 }
@@ -279,9 +289,10 @@ constexpr PairedMetric kPairedMetrics[] = {
     {"c50_error_db", "C50", "dB", &metrics::RirErrors::c50_error_db, 3},
     {"edt_error_s", "EDT", "s", &metrics::RirErrors::edt_error_s, 5}};
 
-// Calls fn(baseline, metric, neraf − baseline) for each baseline present in `e`.
+// Calls fn(other, metric, first − other) for each of `others` present in `e`.
 template <class Fn>
-void for_each_paired(const AudioEval& e, Fn fn) {
+void for_each_paired(const AudioEval& e, const std::string& first,
+                     const std::vector<std::string>& others, Fn fn) {
   const auto find = [&](const std::string& name) -> const AudioMethodEval* {
     for (const auto& m : e.methods)
       if (m.name == name) return &m;
@@ -292,42 +303,46 @@ void for_each_paired(const AudioEval& e, Fn fn) {
     for (const auto& r : m.per_rir) v.push_back(r.*member);
     return v;
   };
-  const AudioMethodEval* neraf = find("neraf");
-  if (!neraf) return;
-  for (const char* name : {"nearest", "linear"}) {
-    const AudioMethodEval* baseline = find(name);
-    if (!baseline) continue;
+  const AudioMethodEval* a = find(first);
+  if (!a) return;
+  for (const std::string& name : others) {
+    const AudioMethodEval* b = find(name);
+    if (!b) continue;
     for (const PairedMetric& m : kPairedMetrics)
-      fn(name, m,
-         metrics::paired_difference(values(*neraf, m.member), values(*baseline, m.member)));
+      fn(name, m, metrics::paired_difference(values(*a, m.member), values(*b, m.member)));
   }
 }
 
 }  // namespace
 
-nlohmann::json paired_to_json(const AudioEval& e) {
+nlohmann::json paired_to_json(const AudioEval& e, const std::string& first,
+                              const std::vector<std::string>& others) {
   nlohmann::json j = nlohmann::json::object();
   for_each_paired(
-      e, [&](const char* baseline, const PairedMetric& m, const metrics::PairedDifference& d) {
-        j[baseline][m.key] = {{"mean_difference", json_number(d.mean)},
-                              {"standard_error", json_number(d.standard_error)},
-                              {"neraf_better", d.first_better},
-                              {"n", d.count}};
+      e, first, others,
+      [&](const std::string& other, const PairedMetric& m, const metrics::PairedDifference& d) {
+        j[other][m.key] = {{"mean_difference", json_number(d.mean)},
+                           {"standard_error", json_number(d.standard_error)},
+                           {"neraf_better", d.first_better},
+                           {"n", d.count}};
       });
   return j;
 }
 
-std::string paired_table(const AudioEval& e) {
+std::string paired_table(const AudioEval& e, const std::string& first,
+                         const std::vector<std::string>& others) {
   std::ostringstream out;
   std::string current;
-  char buf[160];
+  char buf[200];
   for_each_paired(
-      e, [&](const char* baseline, const PairedMetric& m, const metrics::PairedDifference& d) {
-        if (current != baseline) {
+      e, first, others,
+      [&](const std::string& other, const PairedMetric& m, const metrics::PairedDifference& d) {
+        if (current != other) {
           if (current.empty())
-            out << "neraf − baseline per RIR (mean ± standard error; RIRs where neraf is better):";
-          current = baseline;
-          std::snprintf(buf, sizeof buf, "\n  %-8s", baseline);
+            out << first << " − each method below, per RIR (mean ± standard error; RIRs where "
+                << first << " is better):";
+          current = other;
+          std::snprintf(buf, sizeof buf, "\n  %-8s", other.c_str());
           out << buf;
         }
         std::snprintf(buf, sizeof buf, "  %s %+.*f ± %.*f %s (%zu/%zu)", m.label, m.digits, d.mean,
@@ -336,6 +351,59 @@ std::string paired_table(const AudioEval& e) {
       });
   if (!current.empty()) out << "\n";
   return out.str();
+}
+
+namespace {
+
+// "a.b.c" → value for every leaf of `j` (arrays are leaves).
+void flatten(const nlohmann::json& j, const std::string& prefix,
+             std::map<std::string, nlohmann::json>& out) {
+  if (j.is_object()) {
+    for (auto it = j.begin(); it != j.end(); ++it)
+      flatten(it.value(), prefix.empty() ? it.key() : prefix + "." + it.key(), out);
+  } else {
+    out[prefix] = j;
+  }
+}
+
+// The first key (in key order) whose values differ, skipping `ignored`; "" when none.
+std::string first_difference(const nlohmann::json& main, const nlohmann::json& other,
+                             const std::set<std::string>& ignored, const std::string& file) {
+  std::map<std::string, nlohmann::json> a, b;
+  flatten(main, "", a);
+  flatten(other, "", b);
+  std::set<std::string> keys;
+  for (const auto& [k, v] : a) keys.insert(k);
+  for (const auto& [k, v] : b) keys.insert(k);
+  for (const std::string& k : keys) {
+    if (ignored.count(k)) continue;
+    const nlohmann::json none = "(unset)";
+    nlohmann::json x = a.count(k) ? a[k] : none, y = b.count(k) ? b[k] : none;
+    if (k == "audio.vision_run" && x.is_string() && y.is_string()) {  // the same folder
+      std::error_code ec;
+      x = fs::weakly_canonical(x.get<std::string>(), ec).string();
+      y = fs::weakly_canonical(y.get<std::string>(), ec).string();
+    }
+    if (x != y) return file + " " + k + ": " + y.dump() + " vs " + x.dump();
+  }
+  return "";
+}
+
+}  // namespace
+
+std::vector<std::string> ablation_knobs() {
+  return {"audio.grid", "audio.grid_resolution", "audio.relative_geometry"};
+}
+
+std::string training_difference(const nlohmann::json& main_config, const nlohmann::json& main_data,
+                                const nlohmann::json& other_config,
+                                const nlohmann::json& other_data) {
+  std::set<std::string> ignored = {"threads", "save_every", "eval_rays_per_chunk",
+                                   "audio.cache_dir"};
+  for (const std::string& k : ablation_knobs()) ignored.insert(k);
+  std::string d = first_difference(main_config, other_config, ignored, "config.json");
+  if (d.empty()) d = first_difference(main_data, other_data, {"data"}, "data.json");
+  return d;
 }
 
 void write_audio_csv(const std::string& path, const AudioEval& e) {
@@ -357,14 +425,14 @@ void write_audio_csv(const std::string& path, const AudioEval& e) {
 std::string audio_table(const std::vector<AudioMethodEval>& methods) {
   std::ostringstream out;
   char buf[200];
-  std::snprintf(buf, sizeof buf, "%-28s %10s %10s %10s %10s %9s %6s\n", "method", "T60 (%)",
-                "C50 (dB)", "EDT (s)", "STFT err", "invalid", "n");
+  std::snprintf(buf, sizeof buf, "%-28s %10s %10s %10s %10s %9s %6s  %s\n", "method", "T60 (%)",
+                "C50 (dB)", "EDT (s)", "STFT err", "invalid", "n", "post-processing");
   out << buf;
   for (const auto& m : methods) {
     const auto& s = m.summary;
-    std::snprintf(buf, sizeof buf, "%-28s %10.3f %10.4f %10.5f %10.4f %9.3f %6zu\n", m.name.c_str(),
-                  s.t60_error_pct.mean, s.c50_error_db.mean, s.edt_error_s.mean, s.stft_error.mean,
-                  s.invalid_t60.mean, s.count);
+    std::snprintf(buf, sizeof buf, "%-28s %10.3f %10.4f %10.5f %10.4f %9.3f %6zu  %s\n",
+                  m.name.c_str(), s.t60_error_pct.mean, s.c50_error_db.mean, s.edt_error_s.mean,
+                  s.stft_error.mean, s.invalid_t60.mean, s.count, m.post_processing.c_str());
     out << buf;
   }
   return out.str();

@@ -18,6 +18,13 @@
 //            training features (padded to max_len as for training).
 // Metrics per method: mean (and sample std) of t60_error_pct, c50_error_db, edt_error_s,
 // stft_error, and invalid_t60 (fraction of RIRs with an invalid T60), n_rirs.
+//
+// Post-processing, stated per method (AudioMethodEval::post_processing, the table's last column
+// and the JSON's "post_processing"), so that a comparison through Griffin-Lim is read fairly:
+// neraf's prediction may carry the run's energy calibration and early/late balance, fitted on its
+// training RIRs (infer/calibration.h); the linear baseline never does. With a calibrated run,
+// eval therefore also scores the same field without them ("neraf_uncalibrated", options
+// .uncalibrated), with its own paired differences against each baseline.
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -36,6 +43,14 @@ std::vector<int64_t> nearest_training_rirs(const data::RirSet& train_set,
                                            const data::Rir& query, int64_t k,
                                            std::vector<double>* dist = nullptr);
 
+// What a method's waveform is (AudioMethodEval::post_processing).
+inline constexpr const char* kCalibratedGriffinLim =
+    "griffin_lim_calibrated";  // GL of the prediction × the gains fitted on the training RIRs
+inline constexpr const char* kGriffinLim = "griffin_lim";              // GL of the raw magnitudes
+inline constexpr const char* kMeasuredWaveform = "measured_waveform";  // a training RIR as it is
+// The name of the uncalibrated neraf row.
+inline constexpr const char* kUncalibratedName = "neraf_uncalibrated";
+
 struct AudioEvalOptions {
   std::string out_dir;     // per-RIR CSV (audio_per_rir.csv) and PNGs (audio_XXX.png) here
   int64_t num_images = 4;  // predicted | ground-truth log-STFT PNGs for the first N test RIRs
@@ -43,6 +58,11 @@ struct AudioEvalOptions {
   int64_t max_rirs = -1;   // only the first N test RIRs (−1: all)
   uint64_t seed = 0;       // Griffin-Lim initial phases
   bool progress = true;
+  // What `run`'s predictions carry: kCalibratedGriffinLim when it applies its calibration.
+  std::string neraf_post_processing = kGriffinLim;
+  // The same field without its calibration (infer::load_audio_run(..., calibrated = false)),
+  // scored as kUncalibratedName beside "neraf"; nullptr: not scored (an uncalibrated run).
+  const infer::AudioField* uncalibrated = nullptr;
 };
 
 struct AudioMethodEval {
@@ -50,6 +70,7 @@ struct AudioMethodEval {
   std::vector<metrics::RirErrors> per_rir;
   metrics::RirErrorSummary summary;
   double seconds = 0;  // wall time of the scoring (the two baselines: of both together)
+  std::string post_processing = kGriffinLim;  // kCalibratedGriffinLim, kGriffinLim, ...
 };
 
 struct AudioEval {
@@ -68,27 +89,47 @@ AudioEval evaluate_audio(const infer::AudioField& run, const data::RirSet& rirs,
 AudioEval evaluate_audio(const infer::AudioField& run, const data::RirSet& train_set,
                          const std::vector<int64_t>& train_subset, const data::RirSet& test_set,
                          const std::vector<int64_t>& test, const AudioEvalOptions& options = {});
-// neraf only (for ablation runs): method named `label`.
+// neraf only (for ablation runs): method named `label`, its post_processing `post_processing`.
 AudioMethodEval evaluate_audio_model(const infer::AudioField& run, const data::RirSet& rirs,
                                      const std::vector<int64_t>& test, const std::string& label,
-                                     const AudioEvalOptions& options);
+                                     const AudioEvalOptions& options,
+                                     const std::string& post_processing = kGriffinLim);
 
 // {"t60_error_pct", "c50_error_db", "edt_error_s", "stft_error", "invalid_t60", "n_rirs",
 //  "<key>_std" ...}
 nlohmann::json to_json(const metrics::RirErrorSummary& s);
-// {"neraf": {..., "seconds"}, "nearest": {...}, "linear": {...}}
+// {"neraf": {..., "seconds", "post_processing"}, "neraf_uncalibrated": {...}, "nearest": {...},
+//  "linear": {...}}
 nlohmann::json to_json(const AudioEval& e);
-// neraf against each baseline on the same RIRs (metrics::paired_difference of the T60, C50 and
-// EDT errors, neraf − baseline): {"nearest": {"t60_error_pct": {"mean_difference",
-// "standard_error", "neraf_better", "n"}, ...}, "linear": {...}}; empty without baselines.
-nlohmann::json paired_to_json(const AudioEval& e);
-// The same as lines to print under the table ("" without baselines).
-std::string paired_table(const AudioEval& e);
+// Method `first` against each of `others` present in `e`, on the same RIRs
+// (metrics::paired_difference of the T60, C50 and EDT errors, first − other):
+// {"nearest": {"t60_error_pct": {"mean_difference", "standard_error", "neraf_better" (RIRs where
+// `first` is better), "n"}, ...}, "linear": {...}}; empty when `first` or all `others` are absent.
+nlohmann::json paired_to_json(const AudioEval& e, const std::string& first = "neraf",
+                              const std::vector<std::string>& others = {"nearest", "linear"});
+// The same as lines to print under the table ("" when there is nothing to pair).
+std::string paired_table(const AudioEval& e, const std::string& first = "neraf",
+                         const std::vector<std::string>& others = {"nearest", "linear"});
+
+// How the training of an ablation run (`other_*`) differs from the run it is compared with
+// (`main_*`) beyond the ablation knobs: "" when they trained alike, else the first differing
+// setting as "<file> <key>: <other's value> vs <main's value>" (e.g. `config.json modality:
+// "audio" vs "joint"`). *_config: RUN/config.json (infer::to_json of the TrainConfig); *_data:
+// RUN/data.json. Not compared: the ablation knobs (ablation_knobs()), what does not change what
+// is trained (threads, save_every, eval_rays_per_chunk, audio.cache_dir) and the dataset's path
+// (data.json "data"; the manifests beside it compare its contents). audio.vision_run compares
+// the folders, however written.
+std::string training_difference(const nlohmann::json& main_config, const nlohmann::json& main_data,
+                                const nlohmann::json& other_config,
+                                const nlohmann::json& other_data);
+// The config.json keys an ablation may change: audio.grid, audio.grid_resolution,
+// audio.relative_geometry.
+std::vector<std::string> ablation_knobs();
 // Writes "rir_id,method,t60_error_pct,c50_error_db,edt_error_s,stft_error,invalid_t60,
 // t60_pred_s,t60_gt_s,c50_pred_db,c50_gt_db" rows (the last four: channel means of the measured
 // values, to show a bias).
 void write_audio_csv(const std::string& path, const AudioEval& e);
-// A fixed-width table of the methods' means.
+// A fixed-width table of the methods' means, each row with its post-processing.
 std::string audio_table(const std::vector<AudioMethodEval>& methods);
 
 // [C, F, T] log-STFTs → one PNG: prediction (left) | ground truth (right), channel 0, low
