@@ -25,20 +25,24 @@ $NERAF info "$OUT/scene"
 $NERAF synth --preset demo --layout soundspaces --mics random --out "$OUT/novel" --seed 2 \
   --gain-from "$OUT/scene" --force --quiet
 
-step "2/7 train the radiance and acoustic fields jointly (cpu preset)"
+step "2/7 train the radiance and acoustic fields jointly (cpu preset), then the ablations"
 $NERAF train --data "$OUT/scene" --out "$OUT/run" --force
-# Ablations, each the acoustic field alone on the joint run's frozen field (2000 steps, as many
-# audio steps as the joint run): the paper's no-grid and all-zero-grid, and without the
-# relative-geometry inputs (absolute positions only, as the reference's NAcF gets them).
+# Ablations compared fairly: the full model and each ablation train alike (eval refuses any other
+# difference), here the acoustic field alone on the joint run's frozen field, 2000 steps each (as
+# many audio steps as the joint run): the full model, the paper's no-grid and all-zero-grid, and
+# without the relative-geometry inputs (absolute positions only, as the reference's NAcF gets
+# them).
+AUDIO=(train --data "$OUT/scene" --modality audio --vision-run "$OUT/run" --steps 2000 --force)
+$NERAF "${AUDIO[@]}" --out "$OUT/run_audio"
 for grid in none zeros; do
-  $NERAF train --data "$OUT/scene" --modality audio --vision-run "$OUT/run" --grid $grid \
-    --steps 2000 --out "$OUT/ablation_grid_$grid" --force
+  $NERAF "${AUDIO[@]}" --grid $grid --out "$OUT/ablation_grid_$grid"
 done
-$NERAF train --data "$OUT/scene" --modality audio --vision-run "$OUT/run" --no-relative-geometry \
-  --steps 2000 --out "$OUT/ablation_absolute_positions" --force
+$NERAF "${AUDIO[@]}" --no-relative-geometry --out "$OUT/ablation_absolute_positions"
 
-step "3/7 evaluate on the held-out RIRs, new microphone positions and views (baselines and ablations alongside)"
-$NERAF eval --run "$OUT/run" --json "$OUT/eval.json" --novel-data "$OUT/novel" \
+step "3/7 evaluate on the held-out RIRs, new microphone positions and views (baselines alongside), then the ablations against the audio-only full model"
+$NERAF eval --run "$OUT/run" --json "$OUT/eval.json" --novel-data "$OUT/novel"
+$NERAF eval --run "$OUT/run_audio" --json "$OUT/eval_ablations.json" --novel-data "$OUT/novel" \
+  --skip-vision --no-baselines \
   --ablation-runs "$OUT/ablation_grid_none,$OUT/ablation_grid_zeros,$OUT/ablation_absolute_positions"
 
 step "4/7 render a RIR at a new pose and auralize speech with it"
@@ -61,5 +65,6 @@ $NERAF render trajectory --model "$OUT/demo.nrf" --path examples/paths/demo_walk
 rm -rf "$OUT/rirs"
 $NERAF render rir --model "$OUT/demo.nrf" --poses examples/paths/demo_poses.json --out "$OUT/rirs"
 
-printf '\nDemo outputs in %s/: eval.json, rir.wav, speech_in_room.wav, view.png, loudness.png,\n' "$OUT"
-printf 'demo.nrf (the exported acoustic field), speech_walk.wav (a walk through the room), rirs/\n'
+printf '\nDemo outputs in %s/: eval.json, eval_ablations.json, rir.wav, speech_in_room.wav, view.png,\n' "$OUT"
+printf 'loudness.png, demo.nrf (the exported acoustic field), speech_walk.wav (a walk through the\n'
+printf 'room), rirs/\n'

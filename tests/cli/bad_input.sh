@@ -345,6 +345,8 @@ bad "--in" "$NERAF" render trajectory --model "$BASE/model.nrf" \
 bad "not .mp3" "$NERAF" auralize --rir "$WAV" --in "$DRY" --out @OUT@.mp3
 bad "--ablation-runs" "$NERAF" eval --run "$BASE/run" --json @OUT@ --skip-vision \
   --ablation-runs "$BASE/run,$BASE/run"
+# An exported model records no training config, so no ablation can be checked against it.
+bad "needs --run" "$NERAF" eval --model "$BASE/model.nrf" --json @OUT@ --ablation-runs "$BASE/run"
 # A checkpoint copied in under another step's name, a gain from a set of the other layout, a
 # JSON key given twice.
 last=$(ls "$BASE"/run/checkpoints/step-*[0-9].pt | tail -1)

@@ -29,22 +29,47 @@ expect_exit 2 "$NERAF" train --data "$S" --out "$TMP/r2" --modality sound
 
 # --- eval -------------------------------------------------------------------------------------
 expect_exit 0 "$NERAF" eval --run "$R" --json "$TMP/eval.json" --max-views 2 --max-rirs 4 --quiet
-for key in '"neraf"' '"nearest"' '"linear"' '"t60_error_pct"' '"psnr"'; do
+# The calibrated run scored with and without its calibration, each row naming its post-processing.
+for key in '"neraf"' '"neraf_uncalibrated"' '"nearest"' '"linear"' '"t60_error_pct"' '"psnr"' \
+  '"paired_uncalibrated"' '"post_processing": "griffin_lim_calibrated"'; do
   expect_in "$TMP/eval.json" "$key"
 done
+expect_in "$TMP/out" "neraf_uncalibrated"
 expect_file "$R/eval/audio_per_rir.csv"
-# New microphone positions in the same room, and an ablation run with absolute positions only.
+# New microphone positions in the same room, and an ablation compared fairly: the full model and
+# the ablation with absolute positions only, both audio-only on the joint run's frozen field with
+# the same steps and seed.
 expect_exit 0 "$NERAF" synth --preset demo --layout soundspaces --mics random --mic-count 2 \
   --out "$TMP/novel" --seed 4 --gain-from "$S" --quiet
 expect_exit 0 "$NERAF" train --data "$S" --modality audio --vision-run "$R" --steps 2 \
+  --out "$TMP/full" --quiet
+expect_exit 0 "$NERAF" train --data "$S" --modality audio --vision-run "$R" --steps 2 \
   --no-relative-geometry --out "$TMP/absolute" --quiet
-expect_exit 0 "$NERAF" eval --run "$R" --json "$TMP/novel.json" --skip-vision --max-rirs 3 \
+expect_exit 0 "$NERAF" eval --run "$TMP/full" --json "$TMP/novel.json" --skip-vision --max-rirs 3 \
   --novel-data "$TMP/novel" --ablation-runs "$TMP/absolute" --quiet
-for key in '"novel"' '"absolute"' '"relative_geometry": false'; do
+for key in '"novel"' '"absolute"' '"relative_geometry": false' '"paired_ablations"'; do
   expect_in "$TMP/novel.json" "$key"
 done
 expect_in "$TMP/out" "new microphone positions"
-expect_file "$R/eval/audio_novel_per_rir.csv"
+expect_file "$TMP/full/eval/audio_novel_per_rir.csv"
+# An ablation trained unlike the run it is compared with is refused, naming the run and the
+# setting: audio-only against the joint run, another step count, another seed; and with --model.
+expect_exit 1 "$NERAF" eval --run "$R" --json "$TMP/x.json" --skip-vision --max-rirs 1 \
+  --ablation-runs "$TMP/absolute" --quiet
+expect_in "$TMP/err" "absolute was not trained like --run"
+expect_in "$TMP/err" 'config.json modality: "audio" vs "joint"'
+[ ! -e "$TMP/x.json" ] || fail "a refused --ablation-runs wrote $TMP/x.json"
+expect_exit 0 "$NERAF" train --data "$S" --modality audio --vision-run "$R" --steps 3 \
+  --no-relative-geometry --out "$TMP/absolute3" --quiet
+expect_exit 1 "$NERAF" eval --run "$TMP/full" --json "$TMP/x.json" --skip-vision --max-rirs 1 \
+  --ablation-runs "$TMP/absolute3" --quiet
+expect_in "$TMP/err" "absolute3 was not trained like --run"
+expect_in "$TMP/err" "config.json steps: 3 vs 2"
+expect_exit 0 "$NERAF" train --data "$S" --modality audio --vision-run "$R" --steps 2 --seed 5 \
+  --no-relative-geometry --out "$TMP/absolute_seed5" --quiet
+expect_exit 1 "$NERAF" eval --run "$TMP/full" --json "$TMP/x.json" --skip-vision --max-rirs 1 \
+  --ablation-runs "$TMP/absolute,$TMP/absolute_seed5" --quiet
+expect_in "$TMP/err" "config.json seed: 5 vs 42"
 # The same positions at the automatic gain: another scale, refused (it would bias the STFT error).
 expect_exit 0 "$NERAF" synth --preset demo --layout soundspaces --mics random --mic-count 2 \
   --out "$TMP/novel_scaled" --seed 4 --quiet

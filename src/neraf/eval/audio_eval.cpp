@@ -16,6 +16,7 @@
 #include <set>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include "neraf/infer/image_output.h"
 #include "neraf/io/atomic_file.h"
@@ -366,15 +367,25 @@ void flatten(const nlohmann::json& j, const std::string& prefix,
   }
 }
 
-// The first key (in key order) whose values differ, skipping `ignored`; "" when none.
+// The first key whose values differ, skipping `ignored`; "" when none. The keys that say most
+// about a run come first (modality, preset, steps, seed), then shallower keys before deeper ones
+// (steps before audio.schedule.max_steps, which follows it), then by name.
 std::string first_difference(const nlohmann::json& main, const nlohmann::json& other,
                              const std::set<std::string>& ignored, const std::string& file) {
   std::map<std::string, nlohmann::json> a, b;
   flatten(main, "", a);
   flatten(other, "", b);
-  std::set<std::string> keys;
-  for (const auto& [k, v] : a) keys.insert(k);
-  for (const auto& [k, v] : b) keys.insert(k);
+  std::set<std::string> unique;
+  for (const auto& [k, v] : a) unique.insert(k);
+  for (const auto& [k, v] : b) unique.insert(k);
+  const std::vector<std::string> first = {"modality", "preset", "steps", "seed"};
+  const auto rank = [&](const std::string& k) {
+    const auto it = std::find(first.begin(), first.end(), k);
+    return std::make_tuple(it - first.begin(), std::count(k.begin(), k.end(), '.'), k);
+  };
+  std::vector<std::string> keys(unique.begin(), unique.end());
+  std::stable_sort(keys.begin(), keys.end(),
+                   [&](const std::string& x, const std::string& y) { return rank(x) < rank(y); });
   for (const std::string& k : keys) {
     if (ignored.count(k)) continue;
     const nlohmann::json none = "(unset)";
