@@ -56,7 +56,7 @@ for n in $SIZES; do
   /usr/bin/time -f '%M %e' -o "$WORK/eval_$n.time" \
     $NERAF eval --run "$WORK/run_$n" --skip-vision --no-images --max-rirs 200 \
     --json "$WORK/eval_$n.json" --quiet >/dev/null
-  cache=$(du -bL "$sub"/.neraf_cache/*.bin | awk '{s += $1} END {print s}')
+  cache=$(du -bL "$sub"/.neraf_cache/*.bin | awk '{s += $1} END {printf "%.0f", s}')
   read -r train_kb train_s <"$WORK/train_$n.time"
   read -r eval_kb eval_s <"$WORK/eval_$n.time"
   rows+=("{\"rirs\": $n, \"cache_bytes\": $cache, \"train_peak_rss_kb\": $train_kb, \"train_s\": $train_s, \"eval_peak_rss_kb\": $eval_kb, \"eval_s\": $eval_s}")
