@@ -335,6 +335,8 @@ std::string paired_table(const AudioEval& e, const std::string& first,
   std::ostringstream out;
   std::string current;
   char buf[200];
+  int width = 8;  // the longest name of `others`, so that the columns line up
+  for (const std::string& o : others) width = std::max(width, static_cast<int>(o.size()));
   for_each_paired(
       e, first, others,
       [&](const std::string& other, const PairedMetric& m, const metrics::PairedDifference& d) {
@@ -343,7 +345,7 @@ std::string paired_table(const AudioEval& e, const std::string& first,
             out << first << " − each method below, per RIR (mean ± standard error; RIRs where "
                 << first << " is better):";
           current = other;
-          std::snprintf(buf, sizeof buf, "\n  %-8s", other.c_str());
+          std::snprintf(buf, sizeof buf, "\n  %-*s", width, other.c_str());
           out << buf;
         }
         std::snprintf(buf, sizeof buf, "  %s %+.*f ± %.*f %s (%zu/%zu)", m.label, m.digits, d.mean,
