@@ -60,7 +60,7 @@ void BM_AcousticStep(benchmark::State& state) {
     m->zero_grad();
     grid.mutable_grad() = torch::Tensor();
     const auto pred = m->forward(grid, b.t, b.mic, b.src, b.rot);
-    auto loss = sc_slmse_loss(pred, b.gt);
+    auto loss = spectral_loss(pred, b.gt);
     loss.total.backward();
     benchmark::DoNotOptimize(loss.total.item<float>());
   }
@@ -113,7 +113,7 @@ void BM_NacfFwdBwd(benchmark::State& state) {
   for (auto _ : state) {
     net->zero_grad();
     const auto h = nacf_input(o.nacf, feature, b.t, kMaxLen, b.mic, b.src, b.rot);
-    auto loss = sc_slmse_loss(net->forward(h), b.gt);
+    auto loss = spectral_loss(net->forward(h), b.gt);
     loss.total.backward();
     benchmark::DoNotOptimize(loss.total.item<float>());
   }

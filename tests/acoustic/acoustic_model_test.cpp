@@ -156,17 +156,17 @@ TEST(AcousticModel, AudioLossReachesFieldThroughFreshCells) {
   const auto b = random_batch(32, 12);
   const auto gt = torch::randn({32, 2, 33}) - 3.0;
   const auto pred = m->forward(sampler->grid(), b.t, b.mic, b.src, b.rot);
-  sc_slmse_loss(pred, gt).total.backward();
+  spectral_loss(pred, gt).total.backward();
   ASSERT_TRUE(w.grad().defined());
   EXPECT_GT(w.grad().abs().sum().item<float>(), 0.0f);
 
   auto params = m->parameters();
   torch::optim::Adam opt(params, torch::optim::AdamOptions(1e-3).eps(1e-15));
-  const double before = sc_slmse_loss(pred, gt).total.item<double>();
+  const double before = spectral_loss(pred, gt).total.item<double>();
   double after = before;
   for (int i = 0; i < 5; ++i) {
     opt.zero_grad();
-    auto l = sc_slmse_loss(m->forward(sampler->grid().detach(), b.t, b.mic, b.src, b.rot), gt);
+    auto l = spectral_loss(m->forward(sampler->grid().detach(), b.t, b.mic, b.src, b.rot), gt);
     l.total.backward();
     opt.step();
     after = l.total.item<double>();

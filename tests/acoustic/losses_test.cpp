@@ -12,7 +12,7 @@ TEST(AudioLoss, HandComputedScAndSl) {
   // pred log-mags (0, ln 2), gt (ln 3, 0): X = (0.999, 1.999), Y = (2.999, 0.999), Y − X = (2, −1).
   const auto pred = torch::tensor({0.0, std::log(2.0)}, torch::kFloat32).view({1, 1, 2});
   const auto gt = torch::tensor({std::log(3.0), 0.0}, torch::kFloat32).view({1, 1, 2});
-  const auto t = sc_slmse_loss(pred, gt);
+  const auto t = spectral_loss(pred, gt);
   const double sc = std::sqrt(5.0) / std::sqrt(2.999 * 2.999 + 0.999 * 0.999);  // 0.7073897
   const double sl = (std::log(3.0) * std::log(3.0) + std::log(2.0) * std::log(2.0)) / 2.0;
   EXPECT_NEAR(t.sc.item<double>(), sc, 1e-6);
@@ -24,12 +24,33 @@ TEST(AudioLoss, HandComputedScAndSl) {
   EXPECT_NEAR(t.total.item<double>(), 1e-4 * sc + 1e-3 * sl, 1e-10);
 }
 
+TEST(AudioLoss, TheLossStudysOtherCriteriaByHand) {
+  // The same pair as above: |gt − pred| = (ln 3, ln 2).
+  const auto pred = torch::tensor({0.0, std::log(2.0)}, torch::kFloat32).view({1, 1, 2});
+  const auto gt = torch::tensor({std::log(3.0), 0.0}, torch::kFloat32).view({1, 1, 2});
+  const double sc = 0.7073897;
+  AudioLossOptions l1;
+  l1.criterion = AudioCriterion::sc_sll1;
+  const auto a = spectral_loss(pred, gt, l1);
+  const double sl1 = (std::log(3.0) + std::log(2.0)) / 2.0;  // 0.8958797
+  EXPECT_NEAR(a.sl.item<double>(), sl1, 1e-6);
+  EXPECT_NEAR(a.total.item<double>(), 1e-4 * sc + 1e-3 * sl1, 1e-9);
+  AudioLossOptions mse;
+  mse.criterion = AudioCriterion::mse;
+  const auto b = spectral_loss(pred, gt, mse);
+  EXPECT_NEAR(b.sc.item<double>(), sc, 1e-6);  // still reported
+  EXPECT_EQ(b.sc_loss.item<double>(), 0.0);
+  EXPECT_NEAR(b.total.item<double>(), 1e-3 * 0.8437010, 1e-9);
+  EXPECT_EQ(parse_audio_criterion("sc_sll1"), AudioCriterion::sc_sll1);
+  EXPECT_EQ(parse_audio_criterion("SC+SLMSE"), std::nullopt);
+}
+
 TEST(AudioLoss, ScIsOneRatioOverTheWholeBatch) {
   torch::manual_seed(0);
   const auto pred = torch::randn({4, 2, 9});
   auto gt = torch::randn({4, 2, 9});
   gt[0] += 3.0;  // one loud sample dominates the batch norm
-  const auto t = sc_slmse_loss(pred, gt);
+  const auto t = spectral_loss(pred, gt);
   const auto x = torch::exp(pred.to(torch::kFloat64)) - 1e-3;
   const auto y = torch::exp(gt.to(torch::kFloat64)) - 1e-3;
   const double whole = ((y - x).pow(2).sum().sqrt() / y.pow(2).sum().sqrt()).item<double>();
@@ -43,7 +64,7 @@ TEST(AudioLoss, ScIsOneRatioOverTheWholeBatch) {
   const auto low = torch::full({1, 1, 1}, -10.0);
   const auto one = torch::zeros({1, 1, 1});
   const double xl = std::exp(-10.0) - 1e-3;  // < 0
-  EXPECT_NEAR(sc_slmse_loss(low, one).sc.item<double>(), std::abs(0.999 - xl) / 0.999, 1e-6);
+  EXPECT_NEAR(spectral_loss(low, one).sc.item<double>(), std::abs(0.999 - xl) / 0.999, 1e-6);
 }
 
 TEST(AudioLoss, WeightsAreConfigurableAndGradientFlows) {
@@ -53,7 +74,7 @@ TEST(AudioLoss, WeightsAreConfigurableAndGradientFlows) {
   o.mag_weight = 0.5;
   auto pred = torch::zeros({2, 1, 3}, torch::requires_grad());
   const auto gt = torch::ones({2, 1, 3});
-  const auto t = sc_slmse_loss(pred, gt, o);
+  const auto t = spectral_loss(pred, gt, o);
   EXPECT_NEAR(t.mag_loss.item<double>(), 0.5, 1e-6);  // mean((1 − 0)²)·0.5
   EXPECT_NEAR(t.sc_loss.item<double>(), 2.0 * t.sc.item<double>(), 1e-6);
   t.total.backward();

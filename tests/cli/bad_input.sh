@@ -267,6 +267,15 @@ expect_in "$TMP/out" "0 error(s), 1 warning(s)"
 D=""
 bad "$BASE/run" "$NERAF" train --data "$BASE/other_room" --modality audio --vision-run "$BASE/run" \
   --steps 2 --out @OUT@ --quiet
+# The same image names and poses with other pictures (each image swapped for the next one).
+fresh repainted ss
+mapfile -t pictures < <(ls "$D"/images/*.png)
+cp "${pictures[0]}" "$TMP/first.png"
+for ((i = 0; i + 1 < ${#pictures[@]}; ++i)); do cp "${pictures[i + 1]}" "${pictures[i]}"; done
+cp "$TMP/first.png" "${pictures[-1]}"
+bad "training pictures" "$NERAF" train --data "$D" --modality audio --vision-run "$BASE/run" \
+  --steps 2 --out @OUT@ --quiet
+D=""
 fresh run_noconfig run; rm "$D/config.json"
 bad "$D" "$NERAF" eval --run "$D" --json @OUT@ --quiet
 fresh run_badconfig run; echo '{"preset": ' >"$D/config.json"
@@ -358,6 +367,29 @@ bad "--gain-from" "$NERAF" synth --preset demo --layout soundspaces --gain-from 
   --out @OUT@ --quiet
 echo '{"room": {"size": [4, 3, 5], "size": [9, 9, 9]}}' >"$TMP/twice.json"
 bad "appears twice" "$NERAF" synth --scene "$TMP/twice.json" --out @OUT@ --quiet
+# --force restarts a run, never turns another folder into one; outputs that cannot be written
+# fail before the work (a name too long, /proc, a deleted working folder).
+bad "not a neraf run folder" "$NERAF" train --data "$BASE/ss" --out "$BASE/ss/images" --force \
+  --steps 2 --audio-start-step 1 --quiet
+[ -e "$BASE/ss/images/config.json" ] && fail "train --force wrote into a dataset's images folder"
+long=$(printf 'n%.0s' $(seq 1 250))
+bad "shorter name" "$NERAF" synth --preset demo --layout raf --out "$TMP/$long" --quiet
+bad "/proc" "$NERAF" export --run "$BASE/run" --out /proc/neraf_model.nrf
+mkdir -p "$TMP/gone"
+(cd "$TMP/gone" && rmdir "$TMP/gone" &&
+  timeout 60 "$NERAF" synth --preset demo --layout raf --out ds --quiet >"$TMP/out" 2>"$TMP/err")
+got=$?
+classes=$((classes + 1))
+next_out
+check "synth in a deleted working folder" "cannot create files" cmd
+# A mistyped command or option gets a suggestion.
+run "$NERAF" trian --data x
+[ "$got" -eq 2 ] && grep -q "did you mean 'train'" "$TMP/err" ||
+  fail "neraf trian: exit $got, no suggestion: $(head -c 300 "$TMP/err")"
+run "$NERAF" train --data x --out y --stpes 3
+[ "$got" -eq 2 ] && grep -q "did you mean '--steps'" "$TMP/err" ||
+  fail "train --stpes: exit $got, no suggestion: $(head -c 300 "$TMP/err")"
+
 run "$NERAF" info "$BASE/ss" --json
 [ "$got" -eq 0 ] || fail "info --json on a good set exited $got"
 timeout 60 "$NERAF" info "$BASE/ss" --json >/dev/full 2>"$TMP/err"

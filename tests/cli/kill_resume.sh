@@ -90,6 +90,35 @@ rc=$?
 [ -e "$TMP/full" ] && fail "synth on a full disk left $TMP/full"
 [ "$(find "$TMP" -maxdepth 1 -name '.full.tmp-*' | wc -l)" -eq 0 ] || fail "synth left a temporary folder"
 
+# Ctrl-C: training saves a checkpoint and exits 130 ("interrupted: ..."), resumable. A synth
+# stopped by SIGTERM deletes its temporary folder and ends as the signal would (143 in the
+# shell), leaving nothing. (SIGINT for it is not tried: a background job of a script starts with
+# SIGINT ignored, and neraf keeps an ignored signal ignored.)
+"$NERAF" train --out "$R" --resume --steps 100000 --threads 1 --save-every 1000 --quiet \
+  >"$TMP/out" 2>"$TMP/err" &
+pid=$!
+sleep 3
+kill -INT "$pid"
+wait "$pid"
+rc=$?
+[ "$rc" -eq 130 ] || fail "train after Ctrl-C exited $rc, expected 130: $(tail -c 300 "$TMP/err")"
+expect_in "$TMP/err" "^interrupted: training stopped at step"
+[ "$(temporaries)" -eq 0 ] || fail "Ctrl-C during training left $(find "$R" -name '*.tmp-*')"
+newest=$(find "$R/checkpoints" -name 'step-*[0-9].pt' | sort | tail -1)
+[ "$(basename "$newest")" != "step-000000041.pt" ] || fail "Ctrl-C saved no checkpoint"
+expect_exit 0 "$NERAF" train --out "$R" --resume --steps "$((10#$(basename "$newest" .pt | cut -d- -f2) + 1))" --quiet
+"$NERAF" synth --preset demo --layout soundspaces --mics random --mic-count 100 \
+  --out "$TMP/stopped" --seed 3 --quiet >"$TMP/out" 2>"$TMP/err" &
+pid=$!
+sleep 2
+kill -TERM "$pid"
+wait "$pid"
+rc=$?
+[ "$rc" -eq 143 ] || fail "synth after SIGTERM exited $rc, expected 143"
+[ -e "$TMP/stopped" ] && fail "synth stopped by SIGTERM left $TMP/stopped"
+[ "$(find "$TMP" -maxdepth 1 -name '.stopped.tmp-*' | wc -l)" -eq 0 ] ||
+  fail "synth stopped by SIGTERM left its temporary folder"
+
 echo "kill_resume: $restarts kills ($in_write during a checkpoint write, $orphans orphaned temporary" \
   "files, all removed by the next start); newest checkpoint after each kill: ${steps[*]:-none}"
 finish kill_resume

@@ -116,6 +116,8 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
   f.grid = "zeros";
   f.audio_fraction = 0.5;
   f.decay_loss = 0.25;
+  f.audio_loss = "sc_sll1";
+  f.grid_resolution = 16;
   f.no_relative_geometry = true;
   for (Modality m : {Modality::vision, Modality::joint}) {
     const TrainConfig c = resolve("cpu", m, f);
@@ -129,6 +131,8 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
     EXPECT_EQ(c.audio.grid, "zeros");
     EXPECT_EQ(c.audio.fraction, 0.5);
     EXPECT_EQ(c.audio.decay_weight, 0.25);
+    EXPECT_EQ(c.audio.loss, "sc_sll1");
+    EXPECT_EQ(c.audio.grid_resolution, 16);
     EXPECT_FALSE(c.audio.relative_geometry);
   }
   // Unset flags keep the preset's values.
@@ -139,6 +143,9 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
   EXPECT_EQ(cpu.model.precision, preset.model.precision);
   EXPECT_EQ(cpu.audio.decay_weight, preset.audio.decay_weight);
   EXPECT_TRUE(cpu.audio.relative_geometry);
+  EXPECT_EQ(cpu.audio.loss, "sc_slmse");
+  EXPECT_EQ(cpu.audio.grid_resolution, 32);
+  EXPECT_EQ(resolve("paper", Modality::joint).audio.grid_resolution, 128);
   EXPECT_EQ(resolve("paper", Modality::joint).seed, 42u);
 }
 

@@ -4,9 +4,16 @@
 
 namespace neraf::acoustic {
 
-AudioLossTerms sc_slmse_loss(const torch::Tensor& pred, const torch::Tensor& gt,
+std::optional<AudioCriterion> parse_audio_criterion(const std::string& name) {
+  if (name == "sc_slmse") return AudioCriterion::sc_slmse;
+  if (name == "sc_sll1") return AudioCriterion::sc_sll1;
+  if (name == "mse") return AudioCriterion::mse;
+  return std::nullopt;
+}
+
+AudioLossTerms spectral_loss(const torch::Tensor& pred, const torch::Tensor& gt,
                              const AudioLossOptions& options) {
-  TORCH_CHECK(pred.sizes() == gt.sizes(), "sc_slmse_loss: pred ", pred.sizes(), " vs gt ",
+  TORCH_CHECK(pred.sizes() == gt.sizes(), "spectral_loss: pred ", pred.sizes(), " vs gt ",
               gt.sizes());
   const auto p = pred.to(torch::kFloat32);
   const auto g = gt.to(torch::kFloat32);
@@ -14,8 +21,10 @@ AudioLossTerms sc_slmse_loss(const torch::Tensor& pred, const torch::Tensor& gt,
   const auto y = torch::exp(g) - 1e-3;
   AudioLossTerms t;
   t.sc = torch::norm(y - x) / torch::norm(y);  // Frobenius over the whole batch
-  t.sl = torch::mse_loss(p, g);
-  t.sc_loss = t.sc * (options.loss_factor * options.sc_weight);
+  t.sl =
+      options.criterion == AudioCriterion::sc_sll1 ? torch::l1_loss(p, g) : torch::mse_loss(p, g);
+  const double sc_weight = options.criterion == AudioCriterion::mse ? 0.0 : options.sc_weight;
+  t.sc_loss = t.sc * (options.loss_factor * sc_weight);
   t.mag_loss = t.sl * (options.loss_factor * options.mag_weight);
   t.total = t.sc_loss + t.mag_loss;
   return t;

@@ -1,12 +1,14 @@
 #pragma once
 // Audio losses (neraf-reference.md §2.2).
 //
-// "SC+SLMSE" on a batch of predicted / ground-truth log-magnitude frames [B, C, F]
-// (log(|STFT| + 1e-3)):
+// "SC+SLMSE" (the reference's criterion) on a batch of predicted / ground-truth log-magnitude
+// frames [B, C, F] (log(|STFT| + 1e-3)):
 //   X = exp(pred) − 1e-3,  Y = exp(gt) − 1e-3     (no clipping, as the reference)
 //   SC = ‖Y − X‖_F / ‖Y‖_F over the WHOLE batch tensor (one ratio, not a per-sample mean)
 //   SL = mean((gt − pred)²)
 //   audio_sc_loss = loss_factor·sc_weight·SC = 1e-3·0.1·SC,  audio_mag_loss = 1e-3·1.0·SL
+// The paper's loss study also trains with "SC+SLL1" (SL = mean|gt − pred|, the reference's other
+// criterion string) and "MSE" (SL alone: audio_sc_loss is 0, SC is still reported).
 //
 // Energy-decay loss (optional, the paper's "++" variant; the published code only carries it as a
 // comment): on whole RIRs [B, C, F, T] (all T frames of each RIR, in order),
@@ -20,9 +22,18 @@
 // differences, while T60 (down to −35 dB), EDT and C50 only look at the top of the curve.
 #include <torch/types.h>
 
+#include <optional>
+#include <string>
+
 namespace neraf::acoustic {
 
+enum class AudioCriterion { sc_slmse, sc_sll1, mse };
+
+// "sc_slmse" | "sc_sll1" | "mse" (the config's audio.loss, --audio-loss); nullopt otherwise.
+std::optional<AudioCriterion> parse_audio_criterion(const std::string& name);
+
 struct AudioLossOptions {
+  AudioCriterion criterion = AudioCriterion::sc_slmse;
   double loss_factor = 1e-3;
   double sc_weight = 0.1;
   double mag_weight = 1.0;
@@ -33,14 +44,14 @@ struct AudioLossOptions {
 
 struct AudioLossTerms {
   torch::Tensor sc;        // [] raw spectral convergence ‖Y − X‖_F / ‖Y‖_F
-  torch::Tensor sl;        // [] raw mean squared log-magnitude error
+  torch::Tensor sl;        // [] raw log-magnitude error (mean squared; mean absolute for sc_sll1)
   torch::Tensor sc_loss;   // [] audio_sc_loss = loss_factor·sc_weight·sc
   torch::Tensor mag_loss;  // [] audio_mag_loss = loss_factor·mag_weight·sl
   torch::Tensor total;     // [] sc_loss + mag_loss (+ decay_loss when added by the caller)
 };
 
 // pred, gt: [B, C, F] (any equal shape) log-magnitudes.
-AudioLossTerms sc_slmse_loss(const torch::Tensor& pred, const torch::Tensor& gt,
+AudioLossTerms spectral_loss(const torch::Tensor& pred, const torch::Tensor& gt,
                              const AudioLossOptions& options = {});
 
 // pred, gt: [B, C, F, T] log-magnitudes of whole RIRs → [] raw energy-decay L1 (unweighted).

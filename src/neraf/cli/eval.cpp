@@ -121,6 +121,7 @@ nlohmann::json score_audio(const infer::AudioField& run, const std::vector<Ablat
       abl[a.label]["grid"] = a.run.run().config.audio.grid;
       abl[a.label]["grid_resolution"] = a.run.run().config.audio.grid_resolution;
       abl[a.label]["relative_geometry"] = a.run.run().config.audio.relative_geometry;
+      abl[a.label]["loss"] = a.run.run().config.audio.loss;
       abl[a.label]["post_processing"] = m.post_processing;
       labels.push_back(a.label);
       e.methods.push_back(std::move(m));
@@ -338,7 +339,7 @@ void register_eval(CLI::App& app) {
       "the energy calibration and early/late balance fitted on its training RIRs, and\n"
       "\"neraf_uncalibrated\" without, as the linear baseline is rendered (each row states its\n"
       "post-processing). --ablation-runs must have trained exactly as --run but for audio.grid,\n"
-      "audio.grid_resolution or audio.relative_geometry (same modality, preset, steps, seed,\n"
+      "audio.grid_resolution, audio.relative_geometry or audio.loss (same modality, preset, steps, seed,\n"
       "data; else refused). Baselines:\n"
       "nearest = the measured RIR of the closest training mic with the same heading and source;\n"
       "linear = inverse-distance blend of the 2-4 closest such training RIRs' magnitudes +\n"

@@ -66,6 +66,7 @@ void require_safe_output(const FlagPath& out, const std::vector<FlagPath>& input
                          const std::string& run_dir) {
   if (out.path.empty()) return;
   io::require_replaceable_file(out.path);
+  io::require_creatable(out.path);
   for (const FlagPath& in : inputs)
     require(in.path.empty() || !same_file(out.path, in.path),
             out.flag + " " + out.path + ": is also " + in.flag +

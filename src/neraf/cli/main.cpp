@@ -1,17 +1,21 @@
 // neraf: the one program. Parses the command line and dispatches to a subcommand.
-// Exit codes: 0 success, 1 runtime error (one "error: ..." line), 2 usage error (message + usage).
+// Exit codes: 0 success, 1 runtime error (one "error: ..." line), 2 usage error (message + usage),
+// 130 stopped by Ctrl-C / SIGTERM after saving what it could (training's checkpoint).
 #include <fftw3.h>
 #include <malloc.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <new>
 #include <string>
+#include <vector>
 
 #include "neraf/cli/commands.h"
 #include "neraf/cli/system_info.h"
+#include "neraf/io/signal_cleanup.h"
 #include "neraf/util/error.h"
 
 namespace {
@@ -37,6 +41,51 @@ const CLI::App* selected_command(const CLI::App& app) {
   }
 }
 
+// Edit distance with adjacent transpositions ("stpes" is one edit from "steps"), for "did you
+// mean" on a mistyped command or option.
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::vector<size_t>> d(a.size() + 1, std::vector<size_t>(b.size() + 1));
+  for (size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (size_t i = 1; i <= a.size(); ++i)
+    for (size_t j = 1; j <= b.size(); ++j) {
+      d[i][j] = std::min(
+          {d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] != b[j - 1] ? 1 : 0)});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1])
+        d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  return d[a.size()][b.size()];
+}
+
+// " (did you mean 'train'?)" when an argument the command did not expect is close to one of its
+// subcommands (`args`: the command line, when no subcommand was recognised) or long options;
+// "" otherwise.
+std::string suggestion(const CLI::App& command, const std::vector<std::string>& args) {
+  const bool at_root = command.get_parent() == nullptr;
+  for (const std::string& arg : at_root ? args : command.remaining()) {
+    const bool is_option = arg.rfind("--", 0) == 0;
+    if (at_root == is_option) continue;  // the root has subcommands, the others options
+    const std::string word = is_option ? arg.substr(2, arg.find('=') - 2) : arg;
+    std::vector<std::string> names;
+    if (is_option) {
+      for (const CLI::Option* o : command.get_options())
+        for (const std::string& name : o->get_lnames()) names.push_back(name);
+    } else {
+      for (const CLI::App* sub : command.get_subcommands({})) names.push_back(sub->get_name());
+    }
+    std::string best;
+    size_t best_distance = std::max<size_t>(1, word.size() / 3) + 1;
+    for (const std::string& name : names) {
+      const size_t d = edit_distance(word, name);
+      if (d < best_distance) best_distance = d, best = name;
+    }
+    if (!best.empty())
+      return " (did you mean '" + std::string(is_option ? "--" : "") + best + "'?)";
+    if (at_root) break;  // only the first word names a command
+  }
+  return "";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -45,6 +94,9 @@ int main(int argc, char** argv) {
   // from several threads, so FFTW's (process-global) planner must be safe across them.
   fftwf_make_planner_thread_safe();
   neraf::cli::use_all_cores();
+  // Ctrl-C anywhere deletes the temporaries of the output being written (training's own guard
+  // takes over while it runs, to save a checkpoint first).
+  neraf::io::install_signal_cleanup();
   CLI::App app{
       "neraf: neural radiance and acoustic fields (NeRAF) on the CPU.\n"
       "Learns a room's pictures and impulse responses jointly; renders, evaluates and auralizes."};
@@ -75,8 +127,14 @@ int main(int argc, char** argv) {
     std::printf("%s\n", e.what());
     return 0;
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "error: %s\n\n%s", e.what(), selected_command(app)->help().c_str());
+    const CLI::App* command = selected_command(app);
+    std::fprintf(stderr, "error: %s%s\n\n%s", e.what(),
+                 suggestion(*command, std::vector<std::string>(argv + 1, argv + argc)).c_str(),
+                 command->help().c_str());
     return 2;
+  } catch (const neraf::Interrupted& e) {
+    std::fprintf(stderr, "interrupted: %s\n", e.what());
+    return 130;
   } catch (const neraf::Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;

@@ -8,6 +8,7 @@
 
 #include "neraf/cli/commands.h"
 #include "neraf/cli/flag_checks.h"
+#include "neraf/io/atomic_file.h"
 #include "neraf/io/json_file.h"
 #include "neraf/sim/occlusion.h"
 #include "neraf/sim/plan_drawing.h"
@@ -79,6 +80,7 @@ void run_synth(SynthArgs a) {
     return;
   }
   require(!a.out_dir.empty(), "synth: --out DIR is required (the dataset folder to create)");
+  io::require_creatable(a.out_dir);
   if (a.threads > 0) omp_set_num_threads(a.threads);
 
   sim::SynthOptions opt;

@@ -47,6 +47,10 @@ struct TrainArgs {
   CLI::Option* cache_precision_opt = nullptr;
   int64_t max_len = 0;
   CLI::Option* max_len_opt = nullptr;
+  std::string audio_loss = "sc_slmse";
+  CLI::Option* audio_loss_opt = nullptr;
+  int64_t grid_resolution = 32;
+  CLI::Option* grid_resolution_opt = nullptr;
   int keep = 3;
   int64_t save_every = 0;
 };
@@ -140,6 +144,11 @@ void register_train(CLI::App& app) {
                       "paper's ablations")
           ->check(CLI::IsMember({"sampled", "none", "zeros"}))
           ->capture_default_str();
+  args->grid_resolution_opt =
+      cmd->add_option("--grid-resolution", args->grid_resolution,
+                      "S: the acoustic grid's cells per side (default: the preset's, cpu 32, "
+                      "paper 128; the paper's ablation also tries 256)")
+          ->transform(whole_number(8, 256));
   CLI::Option* fraction =
       cmd->add_option("--audio-fraction", args->audio_fraction,
                       "Few-shot: train the acoustic field on this seeded fraction of the training "
@@ -160,6 +169,13 @@ void register_train(CLI::App& app) {
                       "Weight of the energy-decay loss on whole RIRs (the paper's \"++\" "
                       "variant; default 0 = off, as the reference)")
           ->check(real_number(0, 1000));
+  args->audio_loss_opt =
+      cmd->add_option("--audio-loss", args->audio_loss,
+                      "Acoustic training criterion (the paper's loss study): sc_slmse (spectral "
+                      "convergence + log-magnitude MSE, the reference's), sc_sll1 (+ log-magnitude "
+                      "L1) or mse (log-magnitude MSE alone)")
+          ->check(CLI::IsMember({"sc_slmse", "sc_sll1", "mse"}))
+          ->capture_default_str();
   CLI::Option* no_relative = cmd->add_flag(
       "--no-relative-geometry", args->no_relative_geometry,
       "Give the acoustic field absolute positions only, as the reference does (the cpu "
@@ -214,6 +230,8 @@ void register_train(CLI::App& app) {
     flags.audio_fraction = args->audio_fraction;
     if (audio_start->count()) flags.audio_start_step = args->audio_start;
     if (decay_loss->count()) flags.decay_loss = args->decay_loss;
+    if (args->audio_loss_opt->count()) flags.audio_loss = args->audio_loss;
+    if (args->grid_resolution_opt->count()) flags.grid_resolution = args->grid_resolution;
     flags.no_relative_geometry = args->no_relative_geometry;
     if (vision_run->count()) flags.vision_run = args->vision_run;
     infer::TrainConfig cfg = infer::resolve_train_config(flags);
@@ -239,7 +257,8 @@ void register_train(CLI::App& app) {
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json is "
                                      "used); start a new run with --out to change it");
-      for (CLI::Option* o : {args->cache_dir_opt, args->cache_precision_opt, args->max_len_opt})
+      for (CLI::Option* o : {args->cache_dir_opt, args->cache_precision_opt, args->max_len_opt,
+                             args->audio_loss_opt, args->grid_resolution_opt})
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json records "
                                      "it); start a new run with --out to change it");
@@ -259,6 +278,10 @@ void register_train(CLI::App& app) {
         std::printf("; audio log-mag MSE %.4f", s.last_audio_sl);
       std::printf("; checkpoint %s\n", s.checkpoint.c_str());
     }
+    if (s.interrupted)
+      throw Interrupted("training stopped at step " + std::to_string(s.end_step) +
+                        " with its checkpoint saved; continue with: neraf train --out " +
+                        args->out + " --resume");
   });
 }
 

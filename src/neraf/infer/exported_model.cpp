@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "neraf/io/atomic_file.h"
+#include "neraf/io/signal_cleanup.h"
 #include "neraf/neraf_rt.h"
 #include "neraf/util/error.h"
 
@@ -136,6 +137,7 @@ ExportReport export_model(const AudioRun& run, const std::string& path,
   const fs::path folder = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : ".";
   io::remove_stale_temporaries(folder.string());
   const std::string candidate = path + ".tmp-" + std::to_string(static_cast<long long>(getpid()));
+  const io::RemoveOnSignal remove_on_ctrl_c(candidate);
   try {
     rt::write_model_file(candidate, data);
   } catch (const std::exception& e) {

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <string_view>
 
 #include "neraf/infer/checkpoint.h"
 #include "neraf/io/json_file.h"
+#include "neraf/io/sealed_file.h"
 #include "neraf/util/error.h"
 
 namespace fs = std::filesystem;
@@ -82,6 +85,13 @@ nlohmann::json make_data_manifest(const data::ImageSet& images, const std::strin
   // Image paths relative to the dataset folder, so the same data read from another working
   // directory (or by absolute path) matches.
   const fs::path root = fs::path(images.source).parent_path();
+  // The training pictures' pixels, hashed: two rooms with the same image names and poses (two
+  // synth runs of different scenes) still differ here.
+  const torch::Tensor pixels = images.train.images.contiguous();
+  char pixel_hash[17];
+  std::snprintf(pixel_hash, sizeof pixel_hash, "%016llx",
+                static_cast<unsigned long long>(io::fnv1a64(std::string_view(
+                    static_cast<const char*>(pixels.data_ptr()), pixels.nbytes()))));
   auto relative = [&root](const std::vector<std::string>& files) {
     std::vector<std::string> out;
     for (const auto& f : files) out.push_back(fs::path(f).lexically_relative(root).string());
@@ -96,6 +106,7 @@ nlohmann::json make_data_manifest(const data::ImageSet& images, const std::strin
           {"height", k0.height},
           {"width", k0.width},
           {"train_files", relative(images.train.files)},
+          {"train_pixels_fnv1a", pixel_hash},
           {"eval_files", relative(images.eval.files)},
           {"world_transform", matrix_json(images.world_transform)},
           {"world_scale", images.world_scale},
@@ -140,6 +151,9 @@ void check_vision_run_data(const std::string& vision_run, const nlohmann::json& 
     for (size_t c = 0; same && c < a[r].size(); ++c) same = close(a[r][c], b[r][c]);
   }
   if (!same) refuse("camera poses (world_transform)");
+  // Runs from before the pixel hash have none; then the checks above are all there is.
+  if (was.contains("train_pixels_fnv1a") && was["train_pixels_fnv1a"] != now["train_pixels_fnv1a"])
+    refuse("training pictures (train_pixels_fnv1a)");
 }
 
 torch::Tensor manifest_eval_poses(const nlohmann::json& m) {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "neraf/acoustic/losses.h"
 #include "neraf/nerf/config_io.h"
 #include "neraf/util/error.h"
 
@@ -129,6 +130,8 @@ TrainConfig resolve_train_config(const TrainFlags& f) {
   }
   cfg.audio.grid = f.grid;
   if (f.decay_loss) cfg.audio.decay_weight = *f.decay_loss;
+  if (f.audio_loss) cfg.audio.loss = *f.audio_loss;
+  if (f.grid_resolution) cfg.audio.grid_resolution = *f.grid_resolution;
   cfg.audio.fraction = f.audio_fraction;
   if (f.no_relative_geometry) cfg.audio.relative_geometry = false;
   require(cfg.modality == Modality::audio || !f.vision_run,
@@ -185,7 +188,10 @@ void validate(const TrainConfig& c, const std::string& where) {
   require(a.resnet_batch_norm == "grid" || a.resnet_batch_norm == "running",
           where + ".audio.resnet_batch_norm: use grid or running (--preset reference sets it)");
   require(a.batch_size >= 1, where + ".audio.batch_size: must be at least 1");
-  require(a.grid_resolution >= 8, where + ".audio.grid_resolution: must be at least 8");
+  require(a.grid_resolution >= 8 && a.grid_resolution <= 256,
+          where + ".audio.grid_resolution: must be in [8, 256] (--grid-resolution)");
+  require(acoustic::parse_audio_criterion(a.loss).has_value(),
+          where + ".audio.loss: use sc_slmse, sc_sll1 or mse (--audio-loss)");
   require(a.cells_per_update >= 1, where + ".audio.cells_per_update: must be at least 1");
   require(a.nacf_width >= 0 && a.nacf_layers >= 1,
           where + ".audio.nacf_width/nacf_layers: must be >= 0 / >= 1");

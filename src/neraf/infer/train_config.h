@@ -53,6 +53,9 @@ struct AudioConfig {
   int64_t nacf_width = 0;           // 0: the acoustic preset's NAcF trunk; else N layers of this
   int64_t nacf_layers = 5;          //    width (only used when nacf_width > 0)
   double fraction = 1.0;  // few-shot: seeded fraction of the train RIRs used (--audio-fraction)
+  // Training criterion (--audio-loss; the paper's loss study): sc_slmse (the reference's),
+  // sc_sll1 or mse (acoustic/losses.h).
+  std::string loss = "sc_slmse";
   // Energy-decay loss (the paper's "++" variant, off in the reference): its weight (0 = off,
   // --decay-loss) and how many whole RIRs (all frames) per audio step it is computed on.
   double decay_weight = 0.0;
@@ -99,6 +102,7 @@ struct AudioConfig {
     v("nacf_width", nacf_width);
     v("nacf_layers", nacf_layers);
     v("fraction", fraction);
+    v("loss", loss);
     v("decay_weight", decay_weight);
     v("decay_rirs", decay_rirs);
     v("early_fraction", early_fraction);
@@ -176,6 +180,8 @@ struct TrainFlags {
   double audio_fraction = 1.0;               // --audio-fraction
   std::optional<int64_t> audio_start_step;   // --audio-start-step
   std::optional<double> decay_loss;          // --decay-loss
+  std::optional<std::string> audio_loss;     // --audio-loss
+  std::optional<int64_t> grid_resolution;    // --grid-resolution
   bool no_relative_geometry = false;         // --no-relative-geometry
   std::optional<std::string> vision_run;     // --vision-run (stored as an absolute path)
 };
@@ -191,8 +197,9 @@ struct TrainFlags {
 //   - --steps N sets the run length (set_run_length) before that cap.
 //   - --audio-start-step S: start_step = S, and a warm-up that ended where audio started still
 //     ends there (max(0, S)).
-//   - --seed, --grid, --audio-fraction, --decay-loss, --no-relative-geometry, --threads, --rays,
-//     --precision, --vision-run (made absolute) overwrite their setting.
+//   - --seed, --grid, --grid-resolution, --audio-fraction, --audio-loss, --decay-loss,
+//     --no-relative-geometry, --threads, --rays, --precision, --vision-run (made absolute)
+//     overwrite their setting.
 // neraf::Error naming the flag: --vision-run without --modality audio, an unknown preset.
 // The result is not validated here (run_training validates the config it trains).
 TrainConfig resolve_train_config(const TrainFlags& flags);

@@ -6,12 +6,14 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <climits>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
 
+#include "neraf/io/signal_cleanup.h"
 #include "neraf/util/error.h"
 
 namespace fs = std::filesystem;
@@ -75,6 +77,30 @@ void require_replaceable_file(const std::string& path) {
               "; neraf only replaces regular files, so remove it or choose another output path");
 }
 
+void require_creatable(const std::string& path) {
+  fs::path target = fs::path(path).lexically_normal();
+  if (target.filename().empty()) target = target.parent_path();
+  for (const fs::path& part : target) {
+    // Room for the longest temporary name made from it (".NAME.old.tmp-PID").
+    require(part.string().size() + 20 <= NAME_MAX,
+            path + ": the name '" + part.string().substr(0, 40) + "...' is longer than the " +
+                std::to_string(NAME_MAX - 20) + " characters neraf can write; choose a shorter name");
+  }
+  std::error_code ec;
+  fs::path folder = parent_or_dot(target);
+  while (!fs::exists(folder, ec) && folder.has_parent_path() && folder != folder.parent_path())
+    folder = folder.parent_path();
+  require(fs::is_directory(folder, ec),
+          path + ": " + folder.string() + " is not a usable folder (" +
+              (ec ? ec.message() : std::string("not a folder")) + "); choose another output path");
+  const std::string probe = (folder / (".neraf-probe" + pid_suffix())).string();
+  const int fd = ::open(probe.c_str(), O_CREAT | O_EXCL | O_WRONLY | O_CLOEXEC, 0644);
+  require(fd >= 0, path + ": cannot create files in " + folder.string() + " (" +
+                       std::strerror(errno) + "); choose a writable output path");
+  ::close(fd);
+  ::unlink(probe.c_str());
+}
+
 void sync_path(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   require(fd >= 0, path + ": cannot open for flushing (" + std::strerror(errno) + ")");
@@ -92,6 +118,7 @@ void write_atomically(const std::string& path,
   create_parent(target, path);
   require_replaceable_file(path);
   const std::string tmp = path + pid_suffix();
+  const RemoveOnSignal remove_on_ctrl_c(tmp);
   std::error_code ec;
   try {
     write(tmp);
@@ -153,6 +180,7 @@ void write_folder_atomically(const std::string& dir,
   fs::create_directory(tmp, ec);
   require(!ec, dir + ": cannot create a temporary folder beside it (" + ec.message() +
                    "); choose a writable output folder");
+  const RemoveOnSignal remove_on_ctrl_c(tmp.string());
   try {
     write(tmp.string());
     sync_tree(tmp.string());

@@ -36,6 +36,12 @@ void write_folder_atomically(const std::string& dir,
 // neraf::Error unless `path` is absent or a regular file (what write_atomically may replace).
 void require_replaceable_file(const std::string& path);
 
+// Before any work: neraf::Error unless `path` (a file or a folder) could be written there: its
+// name and temporary name fit the file system's limit, and the nearest folder that exists on the
+// way to it takes a new file (so /proc, a read-only disk or a deleted working folder fail now,
+// not after an hour's work). Creates and deletes a probe file; creates nothing else.
+void require_creatable(const std::string& path);
+
 // Removes the temporary files and folders ("*.tmp-<pid>") that processes which no longer exist
 // left in `folder` (a SIGKILL during a write); returns how many. Entries of live processes stay.
 int remove_stale_temporaries(const std::string& folder);

@@ -136,8 +136,10 @@ LossDict AudioBranch::losses(StepContext& ctx) {
   const torch::Tensor rot = rirs_.rots.index_select(0, rir);
   const torch::Tensor pred = model_->forward(grid_->grid(), frame.to(device_), mic.to(device_),
                                              src.to(device_), rot.to(device_));  // [B + D·T, C, F]
+  acoustic::AudioLossOptions loss_options;
+  loss_options.criterion = *acoustic::parse_audio_criterion(config_.audio.loss);  // validated
   const acoustic::AudioLossTerms terms =
-      acoustic::sc_slmse_loss(pred.slice(0, 0, B), gt.slice(0, 0, B));
+      acoustic::spectral_loss(pred.slice(0, 0, B), gt.slice(0, 0, B), loss_options);
   ctx.metrics["audio_sl"] = terms.sl.item<double>();
   LossDict out{{"audio_sc_loss", terms.sc_loss}, {"audio_mag_loss", terms.mag_loss}};
   if (D > 0) {

@@ -9,12 +9,16 @@ namespace {
 // the active guard's flag through a process-wide pointer. It is set and cleared by the guard's
 // constructor/destructor only; lock-free atomics are async-signal-safe.
 std::atomic<std::atomic<bool>*> g_active_flag{nullptr};
+// The handlers the guard replaced, written before its own is installed.
+struct sigaction g_previous_int {};
+struct sigaction g_previous_term {};
 
 extern "C" void on_interrupt(int sig) {
   std::atomic<bool>* flag = g_active_flag.load();
   if (flag) flag->store(true);
-  // The next signal of this kind terminates the process as usual.
-  signal(sig, SIG_DFL);
+  // The next signal of this kind goes to the handler from before (io/signal_cleanup.h: delete
+  // the temporaries being written, then end the process).
+  sigaction(sig, sig == SIGINT ? &g_previous_int : &g_previous_term, nullptr);
 }
 }  // namespace
 
@@ -26,6 +30,8 @@ InterruptGuard::InterruptGuard() {
   sa.sa_handler = on_interrupt;
   sigemptyset(&sa.sa_mask);
   sa.sa_flags = 0;
+  sigaction(SIGINT, nullptr, &g_previous_int);
+  sigaction(SIGTERM, nullptr, &g_previous_term);
   sigaction(SIGINT, &sa, &old_int_);
   sigaction(SIGTERM, &sa, &old_term_);
 }

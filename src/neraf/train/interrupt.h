@@ -8,8 +8,9 @@
 namespace neraf::train {
 
 // Installs SIGINT and SIGTERM handlers for its lifetime (restoring the previous ones after).
-// The flag is owned by this object. A second Ctrl-C while the first is being handled falls back
-// to the default action (terminate); checkpoints are written atomically, so that is safe.
+// The flag is owned by this object. A second Ctrl-C while the first is being handled goes to the
+// handler from before (io/signal_cleanup.h: delete the temporaries being written, terminate);
+// checkpoints are written atomically, so that is safe.
 // At most one InterruptGuard may exist at a time (std::logic_error otherwise).
 class InterruptGuard {
  public:

@@ -100,6 +100,13 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
                                ": folder is not empty; pass --resume to continue this run or "
                                "--force to start over (deletes its checkpoints)");
     std::error_code ec;
+    // --force restarts a run; it must not turn any other folder (a dataset, a home folder) into
+    // one.
+    require(
+        fs::exists(config_path, ec) || fs::is_directory(infer::checkpoint_dir(options.run_dir), ec),
+        options.run_dir +
+            ": not a neraf run folder (no config.json or checkpoints/), so --force will not "
+            "train into it; choose a new or empty folder for --out");
     fs::remove_all(infer::checkpoint_dir(options.run_dir), ec);
     fs::remove(config_path, ec);
     fs::remove(manifest_path, ec);
@@ -237,11 +244,7 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
     if (done) break;
   }
   progress.finish();
-  if (summary.interrupted) {
-    info("interrupted: checkpoint saved at step " + std::to_string(summary.end_step) +
-         "; continue with --resume");
-    return summary;
-  }
+  if (summary.interrupted) return summary;  // the caller says so (cli: exit 130)
   calibrate_if_needed(cfg, options.run_dir, summary.checkpoint, summary.end_step, rirs.get());
   return summary;
 }

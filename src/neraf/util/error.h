@@ -11,6 +11,14 @@ class Error : public std::runtime_error {
   explicit Error(const std::string& message) : std::runtime_error(message) {}
 };
 
+// The user stopped a command (Ctrl-C, SIGTERM) and it stopped cleanly, having saved what it could;
+// the CLI prints "interrupted: <message>" and exits 130 (as a shell reports a SIGINT), so scripts
+// can tell a stopped run from a finished one.
+class Interrupted : public Error {
+ public:
+  explicit Interrupted(const std::string& message) : Error(message) {}
+};
+
 // Throws Error(message) when `condition` is false. For user-facing checks, not for invariants.
 inline void require(bool condition, const std::string& message) {
   if (!condition) throw Error(message);
