@@ -2,8 +2,9 @@
 # The NeRAF paper's experiments, reproduced on simulated rooms with the cpu preset (issue 13):
 #   1. neraf vs nearest / linear interpolation: a SoundSpaces-layout binaural room and a
 #      RAF-layout mono room with directional sources; held-out split and new microphone positions
-#   2. the grid ablation (no grid, zero grid, S = 16 / 32 / 64) on the occluded room and on the
-#      furnished / empty pair
+#   2. the grid ablation (no grid, zero grid, S = 24 / 32 / 64) on the occluded room and on the
+#      furnished / empty pair (S = 16 cannot pass the scene encoder, which halves the grid four
+#      times: BatchNorm would see one voxel)
 #   3. few-shot: 25 / 50 / 75 / 100 % of the training RIRs, baselines given the same RIRs
 #   4. cross-modal vision: vision-only vs joint with 10 / 20 / 40 training views
 #   5. the loss study: SC+SL-MSE vs SC+SL-L1 vs MSE
@@ -127,10 +128,10 @@ for e in $EXPERIMENTS; do
           train "e2_${r}_full_s$s" "${a[@]}"
           train "e2_${r}_grid_none_s$s" "${a[@]}" --grid none
           train "e2_${r}_grid_zeros_s$s" "${a[@]}" --grid zeros
-          train "e2_${r}_S16_s$s" "${a[@]}" --grid-resolution 16
+          train "e2_${r}_S24_s$s" "${a[@]}" --grid-resolution 24
           train "e2_${r}_S64_s$s" "${a[@]}" --grid-resolution 64
           abl=$OUT/runs/e2_${r}_grid_none_s$s,$OUT/runs/e2_${r}_grid_zeros_s$s
-          abl+=,$OUT/runs/e2_${r}_S16_s$s,$OUT/runs/e2_${r}_S64_s$s
+          abl+=,$OUT/runs/e2_${r}_S24_s$s,$OUT/runs/e2_${r}_S64_s$s
           evaluate "e2_${r}_s$s" "e2_${r}_full_s$s" --novel-data "$OUT/data/${r}_novel" \
             --skip-vision --ablation-runs "$abl"
         done

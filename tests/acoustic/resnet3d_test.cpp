@@ -156,3 +156,22 @@ TEST(ResNet3d, RejectsBadInput) {
 
 }  // namespace
 }  // namespace neraf::acoustic
+
+namespace neraf::acoustic {
+namespace {
+
+TEST(ResNet3d, SmallestGridIsTheOneThatLeavesTwoVoxelsPerSide) {
+  for (const ResNet3dOptions& o : {resnet3d_cpu_options(), resnet3d_paper_options()}) {
+    EXPECT_EQ(resnet3d_min_grid_resolution(o), 17);
+    ResNet3d net(o);
+    net->train();
+    EXPECT_NO_THROW(net->forward(torch::randn({1, 7, 17, 17, 17})));
+    EXPECT_THROW(net->forward(torch::randn({1, 7, 16, 16, 16})), c10::Error);
+  }
+  ResNet3dOptions no_pool = resnet3d_cpu_options();
+  no_pool.stem_max_pool = false;
+  EXPECT_EQ(resnet3d_min_grid_resolution(no_pool), 9);  // three halvings: 9 → 5 → 3 → 2
+}
+
+}  // namespace
+}  // namespace neraf::acoustic

@@ -249,6 +249,18 @@ TEST(TrainConfig, ReferencePresetIsThePublishedModel) {
   EXPECT_NO_THROW(validate(joint, "config.json"));
 }
 
+TEST(TrainConfig, GridResolutionMustPassTheSceneEncoder) {
+  TrainConfig c = train_preset("cpu");
+  c.modality = Modality::audio;
+  c.audio.grid_resolution = 16;  // halved four times: one voxel at the last BatchNorm
+  EXPECT_THROW(validate(c, "config.json"), Error);
+  c.audio.grid_resolution = 17;
+  EXPECT_NO_THROW(validate(c, "config.json"));
+  c.audio.grid_resolution = 16;
+  c.audio.grid = "none";  // no encoder
+  EXPECT_NO_THROW(validate(c, "config.json"));
+}
+
 TEST(ResolveTrainConfig, UnknownPresetIsAnError) {
   TrainFlags f;
   f.preset = "gpu";

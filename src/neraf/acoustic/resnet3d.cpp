@@ -23,6 +23,15 @@ ResNet3dOptions resnet3d_cpu_options() {
   return o;
 }
 
+int64_t resnet3d_min_grid_resolution(const ResNet3dOptions& options) {
+  int64_t halvings = 1 + (options.stem_max_pool ? 1 : 0);  // stem conv (stride 2), max pool
+  for (int64_t stride : options.strides) halvings += stride == 2 ? 1 : 0;
+  // Side after one halving: ceil(S / 2); the last side must be at least 2.
+  int64_t side = 2;
+  for (int64_t i = 0; i < halvings; ++i) side = 2 * side - 1;
+  return side;
+}
+
 int64_t resnet3d_expansion(ResBlock block) { return block == ResBlock::kBottleneck ? 4 : 1; }
 
 int64_t resnet3d_out_features(const ResNet3dOptions& options) {

@@ -58,6 +58,9 @@ ResNet3dOptions resnet3d_paper_options();  // ResNet3D-50 truncated after layer3
 ResNet3dOptions resnet3d_cpu_options();    // small BasicBlock variant, 256 features
 
 int64_t resnet3d_expansion(ResBlock block);  // 4 for Bottleneck, 1 for Basic
+// The smallest grid side S that leaves more than one voxel per channel at the last BatchNorm (the
+// stem, the max pool and every strided stage halve the grid, rounding up): 17 for both presets.
+int64_t resnet3d_min_grid_resolution(const ResNet3dOptions& options);
 int64_t resnet3d_out_features(const ResNet3dOptions& options);
 
 class ResBlock3dImpl : public torch::nn::Module {
@@ -79,7 +82,7 @@ class ResNet3dImpl : public torch::nn::Module {
   explicit ResNet3dImpl(ResNet3dOptions options = resnet3d_paper_options());
 
   // x: [B, in_channels, S, S, S] → [B, out_features]. S must leave > 1 voxel per channel at every
-  // BatchNorm in train mode with B = 1 (S ≥ 32 for both presets).
+  // BatchNorm in train mode with B = 1 (S ≥ resnet3d_min_grid_resolution).
   torch::Tensor forward(const torch::Tensor& x);
   // The map before pooling: [B, out_features, S', S', S'] (S' = 8 for the paper preset at 128³).
   torch::Tensor feature_map(const torch::Tensor& x);

@@ -147,8 +147,8 @@ void register_train(CLI::App& app) {
   args->grid_resolution_opt =
       cmd->add_option("--grid-resolution", args->grid_resolution,
                       "S: the acoustic grid's cells per side (default: the preset's, cpu 32, "
-                      "paper 128; the paper's ablation also tries 256)")
-          ->transform(whole_number(8, 256));
+                      "paper 128; at least 17, which the scene encoder halves four times)")
+          ->transform(whole_number(17, 256));
   CLI::Option* fraction =
       cmd->add_option("--audio-fraction", args->audio_fraction,
                       "Few-shot: train the acoustic field on this seeded fraction of the training "

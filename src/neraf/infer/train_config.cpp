@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "neraf/acoustic/acoustic_model.h"
 #include "neraf/acoustic/losses.h"
 #include "neraf/nerf/config_io.h"
 #include "neraf/util/error.h"
@@ -188,8 +189,12 @@ void validate(const TrainConfig& c, const std::string& where) {
   require(a.resnet_batch_norm == "grid" || a.resnet_batch_norm == "running",
           where + ".audio.resnet_batch_norm: use grid or running (--preset reference sets it)");
   require(a.batch_size >= 1, where + ".audio.batch_size: must be at least 1");
-  require(a.grid_resolution >= 8 && a.grid_resolution <= 256,
-          where + ".audio.grid_resolution: must be in [8, 256] (--grid-resolution)");
+  // The scene encoder halves the grid four times; BatchNorm needs more than one voxel at the end.
+  const int64_t min_side =
+      acoustic::resnet3d_min_grid_resolution(acoustic::acoustic_preset(c.preset, 1, 1, 1).resnet);
+  require(a.grid == "none" || (a.grid_resolution >= min_side && a.grid_resolution <= 256),
+          where + ".audio.grid_resolution: must be in [" + std::to_string(min_side) +
+              ", 256] for the scene encoder of preset " + c.preset + " (--grid-resolution)");
   require(acoustic::parse_audio_criterion(a.loss).has_value(),
           where + ".audio.loss: use sc_slmse, sc_sll1 or mse (--audio-loss)");
   require(a.cells_per_update >= 1, where + ".audio.cells_per_update: must be at least 1");
