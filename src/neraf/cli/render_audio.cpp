@@ -342,6 +342,10 @@ void add_field_options(CLI::App* cmd, FieldArgs& a, bool poses) {
                   "or bf16 (as a bf16 run trained)")
       ->check(CLI::IsMember({"fp32", "bf16"}))
       ->needs(a.run_opt);
+  cmd->add_option("--scene", a.scene,
+                  "The scene of a multi-scene --run (neraf train with several --data): its name "
+                  "(the dataset folder's) or index")
+      ->needs(a.run_opt);
   if (poses) {
     cmd->add_flag("--allow-outside", a.allow_outside,
                   "Render poses outside the field's training box (train microphones +- 1 m) "
@@ -361,7 +365,8 @@ LoadedField load_field(const FieldArgs& a) {
   }
   if (a.run.empty()) throw CLI::RequiredError("--run or --model");
   auto run = std::make_unique<infer::AudioRun>(infer::load_audio_run(
-      a.run, torch::kCPU, a.checkpoint, nerf::parse_precision(a.precision, "--precision")));
+      a.run, torch::kCPU, a.checkpoint, nerf::parse_precision(a.precision, "--precision"),
+      /*calibrated=*/true, infer::scene_flag(a.run, a.scene)));
   out.step = run->step();
   out.name = a.run;
   out.field = std::move(run);
