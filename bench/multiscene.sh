@@ -6,8 +6,10 @@
 #      large_live (12 × 4.5 × 9 m hall, hard surfaces);
 #   2. a short vision run per room (its radiance field fills that room's grid);
 #   3. per seed: one audio run per room on its own (AUDIO_STEPS steps), and one audio run over all
-#      three rooms (3 × AUDIO_STEPS steps: the same number of batches per room, as the batches mix
-#      the rooms in proportion to their training RIRs) with --grid sampled, zeros and none;
+#      three rooms with --grid sampled, zeros and none, of 3 × AUDIO_STEPS steps: the same total
+#      number of training slices as the three single runs together (the compute budget of
+#      training them separately), which the batches spread over the rooms in proportion to their
+#      training RIRs (and frames: the rooms share the longest room's frame count);
 #   4. `neraf eval` of every run on each room's held-out split; per-RIR paired differences
 #      (multi − single, sampled − zeros / none) with standard errors from the per-RIR CSVs.
 # Quality only (not timing): run it with THREADS=1 and without the build lock.

@@ -244,10 +244,10 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
                 label != "nearest" && label != "linear",
             "--ablation-runs: two runs (or a run and a method) are called '" + label +
                 "' (each is labelled by its folder's name); give each its own folder name");
-    ablations.push_back({dir, label,
-                         infer::load_audio_run(dir, torch::kCPU, "",
-                                               nerf::parse_precision(args.precision),
-                                               /*calibrated=*/true, source.scene)});
+    ablations.push_back(
+        {dir, label,
+         infer::load_audio_run(dir, torch::kCPU, "", nerf::parse_precision(args.precision),
+                               /*calibrated=*/true, source.scene)});
     infer::check_audio_manifest(ablations.back().run.run().manifest.at("audio"), rirs,
                                 dir + "/data.json");
     check_trained_alike(*source.run, args.run, ablations.back().run, dir);
@@ -316,7 +316,8 @@ nlohmann::json mean_over_scenes(const std::vector<nlohmann::json>& scenes) {
   for (const auto& [k, v] : scenes.front().items())
     if (v.is_object() && v.contains("t60_error_pct")) methods.push_back({"", k});
   if (scenes.front().contains("ablations"))
-    for (const auto& [k, v] : scenes.front()["ablations"].items()) methods.push_back({"ablations", k});
+    for (const auto& [k, v] : scenes.front()["ablations"].items())
+      methods.push_back({"ablations", k});
   for (const auto& [group, name] : methods) {
     nlohmann::json m;
     int64_t count = 0;
@@ -356,9 +357,8 @@ nlohmann::json mean_over_scenes(const std::vector<nlohmann::json>& scenes) {
           count += d.value("n", int64_t{0});
         }
         if (!ok) continue;
-        mean[group][other][key] = {{"mean_difference", sum / n},
-                                   {"standard_error", std::sqrt(var) / n},
-                                   {"n", count}};
+        mean[group][other][key] = {
+            {"mean_difference", sum / n}, {"standard_error", std::sqrt(var) / n}, {"n", count}};
       }
   }
   return mean;
@@ -539,8 +539,7 @@ void register_eval(CLI::App& app) {
             const std::vector<std::string> names = infer::scene_names(manifest);
             require(names.size() == cfg.audio.vision_runs.size(),
                     args->run + "/data.json: does not list the run's scenes; re-run neraf train");
-            nlohmann::json audio = {{"scenes", nlohmann::json::object()},
-                                    {"scene_order", names}};
+            nlohmann::json audio = {{"scenes", nlohmann::json::object()}, {"scene_order", names}};
             std::vector<nlohmann::json> per_scene;
             for (size_t k = 0; k < names.size(); ++k) {
               const int64_t scene = static_cast<int64_t>(k);
@@ -583,20 +582,23 @@ void register_eval(CLI::App& app) {
             for (const auto& [name, v] : m.items())
               if (v.contains("t60_error_pct"))
                 std::printf("  %-20s T60 %8.3f %%  C50 %7.3f dB  EDT %8.5f s  STFT %7.4f\n",
-                            name.c_str(), v["t60_error_pct"].is_number() ? v["t60_error_pct"].get<double>() : NAN,
+                            name.c_str(),
+                            v["t60_error_pct"].is_number() ? v["t60_error_pct"].get<double>() : NAN,
                             v["c50_error_db"].is_number() ? v["c50_error_db"].get<double>() : NAN,
                             v["edt_error_s"].is_number() ? v["edt_error_s"].get<double>() : NAN,
                             v["stft_error"].is_number() ? v["stft_error"].get<double>() : NAN);
             if (m.contains("ablations"))
               for (const auto& [name, v] : m["ablations"].items())
                 std::printf("  %-20s T60 %8.3f %%  C50 %7.3f dB  EDT %8.5f s  STFT %7.4f\n",
-                            name.c_str(), v["t60_error_pct"].is_number() ? v["t60_error_pct"].get<double>() : NAN,
+                            name.c_str(),
+                            v["t60_error_pct"].is_number() ? v["t60_error_pct"].get<double>() : NAN,
                             v["c50_error_db"].is_number() ? v["c50_error_db"].get<double>() : NAN,
                             v["edt_error_s"].is_number() ? v["edt_error_s"].get<double>() : NAN,
                             v["stft_error"].is_number() ? v["stft_error"].get<double>() : NAN);
             if (!args->skip_vision)
-              std::printf("vision: not scored for a multi-scene acoustic run (it has no radiance "
-                          "field of its own); eval each scene's --vision-run\n");
+              std::printf(
+                  "vision: not scored for a multi-scene acoustic run (it has no radiance "
+                  "field of its own); eval each scene's --vision-run\n");
             return;
           }
           if (cfg.modality != infer::Modality::vision) {

@@ -244,8 +244,8 @@ void add_render_loudness(CLI::App& render) {
   cmd->callback([args] {
     if (args->threads > 0) torch::set_num_threads(args->threads);
     const geometry::Vec3 src = parse_flag_position(args->pose.src, "--src");
-    require_safe_output({"--out", args->out}, {{"--csv", args->csv}, {"--model", args->field.model}},
-                        args->field.run);
+    require_safe_output({"--out", args->out},
+                        {{"--csv", args->csv}, {"--model", args->field.model}}, args->field.run);
     require_safe_output({"--csv", args->csv}, {{"--model", args->field.model}}, args->field.run);
     const LoadedField field = load_field(args->field);
     const infer::AudioRunInfo& info = field.field->info();

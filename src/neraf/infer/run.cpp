@@ -192,8 +192,9 @@ int64_t scene_flag(const std::string& run_dir, const std::string& selector,
   if (selector.empty()) return -1;
   const std::string path = run_file(run_dir, "data.json");
   std::error_code ec;
-  require(fs::is_regular_file(path, ec),
-          run_dir + ": not a training run (no data.json); point --run at a neraf train --out folder");
+  require(
+      fs::is_regular_file(path, ec),
+      run_dir + ": not a training run (no data.json); point --run at a neraf train --out folder");
   return find_scene(io::read_json(path), selector, run_dir, flag);
 }
 
@@ -232,8 +233,9 @@ LoadedRun load_run(const std::string& run_dir, torch::Device device,
   run.config = train_config_from_json(io::read_json(config_path), config_path);
   run.manifest = io::read_json(manifest_path);
   require(!is_multiscene(run.manifest),
-          run_dir + ": a multi-scene acoustic run has no radiance field of its own; use its "
-                    "scenes' vision runs (audio.vision_runs in its config.json)");
+          run_dir +
+              ": a multi-scene acoustic run has no radiance field of its own; use its "
+              "scenes' vision runs (audio.vision_runs in its config.json)");
   require(run.manifest.value("format", "") == kManifestFormat && run.manifest.contains("num_train"),
           manifest_path + ": not a neraf run data manifest; re-run neraf train");
   if (checkpoint.empty()) {

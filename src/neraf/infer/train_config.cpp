@@ -217,11 +217,13 @@ void validate(const TrainConfig& c, const std::string& where) {
                                        "(--vision-run)");
   if (!a.vision_runs.empty()) {
     require(c.modality == Modality::audio,
-            where + ".audio.vision_runs: a multi-scene run trains --modality audio (on each "
-                    "scene's frozen vision run); joint multi-scene training is not implemented");
+            where +
+                ".audio.vision_runs: a multi-scene run trains --modality audio (on each "
+                "scene's frozen vision run); joint multi-scene training is not implemented");
     require(a.vision_runs.size() >= 2 && a.vision_runs.front() == a.vision_run,
-            where + ".audio.vision_runs: needs 2 or more runs, the first equal to "
-                    "audio.vision_run (one --vision-run per --data)");
+            where +
+                ".audio.vision_runs: needs 2 or more runs, the first equal to "
+                "audio.vision_run (one --vision-run per --data)");
   }
   if (c.modality != Modality::vision)
     require(a.start_step < c.steps, where + ".audio.start_step: audio starts after step " +

@@ -36,10 +36,10 @@ AudioBranch::AudioBranch(const TrainConfig& config, const std::vector<const data
     require(!r->train.empty(), r->root +
                                    ": the audio train split is empty; the acoustic field "
                                    "needs training RIRs");
-    require(r->channels == first.channels && r->n_freq == first.n_freq &&
-                r->max_len == first.max_len,
-            r->root + ": its RIRs differ in channels, frequencies or frames from " + first.root +
-                "; one acoustic field needs scenes of one format");
+    require(
+        r->channels == first.channels && r->n_freq == first.n_freq && r->max_len == first.max_len,
+        r->root + ": its RIRs differ in channels, frequencies or frames from " + first.root +
+            "; one acoustic field needs scenes of one format");
   }
   const acoustic::AcousticModelOptions opts = infer::audio_model_options(
       config_, first.channels, first.n_freq, first.max_len, first.audio_aabb);
@@ -158,8 +158,8 @@ std::pair<torch::Tensor, torch::Tensor> AudioBranch::forward_scenes(const torch:
       const Scene& sc = scenes_[s];
       const torch::Tensor rir = torch::tensor(rirs, torch::kInt64);
       const torch::Tensor f = frame.index_select(0, torch::tensor(rows, torch::kInt64));
-      torch::Tensor gt = torch::empty(
-          {rir.size(0), sc.rirs->channels, sc.rirs->n_freq}, torch::kFloat32);  // [b, C, F]
+      torch::Tensor gt = torch::empty({rir.size(0), sc.rirs->channels, sc.rirs->n_freq},
+                                      torch::kFloat32);  // [b, C, F]
       sc.rirs->gather_into(rir, f, gt);
       if (!features[s].defined() && model_->options().grid_mode != acoustic::GridMode::kNone)
         features[s] = model_->scene_feature(sc.grid->grid());  // [G], once per scene and step
@@ -258,8 +258,9 @@ void AudioBranch::load(torch::serialize::InputArchive& archive, const std::strin
   torch::Tensor n_scenes;
   const int64_t stored = archive.try_read("num_scenes", n_scenes) ? n_scenes.item<int64_t>() : 1;
   require(stored == static_cast<int64_t>(scenes_.size()),
-          where + ": checkpoint was trained on " + std::to_string(stored) + " scene(s), this run has " +
-              std::to_string(scenes_.size()) + "; resume with the run's own --data");
+          where + ": checkpoint was trained on " + std::to_string(stored) +
+              " scene(s), this run has " + std::to_string(scenes_.size()) +
+              "; resume with the run's own --data");
   for (size_t s = 0; s < scenes_.size(); ++s) {
     c10::IValue manifest;
     require(archive.try_read(infer::scene_key("manifest", s), manifest) && manifest.isString(),

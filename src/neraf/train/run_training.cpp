@@ -104,7 +104,8 @@ std::vector<SceneData> load_scenes(TrainConfig& cfg, const TrainRunOptions& opti
     sc.manifest = infer::make_data_manifest(sc.images, sc.data_dir);
     // Each scene's grid must come from its own room's field (the one-scene run's check).
     infer::check_vision_run_data(cfg.audio.vision_runs[s], sc.manifest);
-    sc.rirs = std::make_unique<data::RirSet>(load_rirs(cfg, options, sc.data_dir, cfg.audio.max_len));
+    sc.rirs =
+        std::make_unique<data::RirSet>(load_rirs(cfg, options, sc.data_dir, cfg.audio.max_len));
     if (s > 0) {
       const nlohmann::json a = infer::make_audio_manifest(*scenes.front().rirs),
                            b = infer::make_audio_manifest(*sc.rirs);
@@ -272,10 +273,11 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
 
   const std::string what =
       multi ? std::to_string(scenes.size()) + " scenes, " + std::to_string([&] {
-        int64_t n = 0;
-        for (const auto* r : all_rirs) n += static_cast<int64_t>(r->train.size());
-        return n;
-      }()) + " train RIRs"
+                int64_t n = 0;
+                for (const auto* r : all_rirs) n += static_cast<int64_t>(r->train.size());
+                return n;
+              }()) +
+                  " train RIRs"
             : std::to_string(scenes.front().images.train.size()) + " train / " +
                   std::to_string(scenes.front().images.eval.size()) + " eval images";
   info("training " + infer::to_string(cfg.modality) + " (preset " + cfg.preset + ", " + what +

@@ -272,8 +272,7 @@ std::unique_ptr<Trainer> make_multiscene_trainer(const TrainConfig& config,
                                                  const std::vector<const data::RirSet*>& scenes,
                                                  torch::Device device) {
   validate(config, "config");
-  require(config.modality == Modality::audio &&
-              config.audio.vision_runs.size() == scenes.size(),
+  require(config.modality == Modality::audio && config.audio.vision_runs.size() == scenes.size(),
           "multi-scene: one --vision-run per --data (--modality audio)");
   auto trainer = std::make_unique<Trainer>(config, device);
   std::vector<nerf::NerfactoModel> fields;
