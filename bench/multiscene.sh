@@ -10,6 +10,8 @@
 #      number of training slices as the three single runs together (the compute budget of
 #      training them separately), which the batches spread over the rooms in proportion to their
 #      training RIRs (and frames: the rooms share the longest room's frame count);
+#      and, as a control for the multi-scene run's 3× optimizer steps, one run per room on its own
+#      with 3 × AUDIO_STEPS steps too ("single_long");
 #   4. `neraf eval` of every run on each room's held-out split; per-RIR paired differences
 #      (multi − single, sampled − zeros / none) with standard errors from the per-RIR CSVs.
 # Quality only (not timing): run it with THREADS=1 and without the build lock.
@@ -40,14 +42,17 @@ multi_data=()
 for r in "${ROOMS[@]}"; do multi_data+=(--data "$WORK/$r" --vision-run "$WORK/v-$r"); done
 for seed in $SEEDS; do
   for r in "${ROOMS[@]}"; do
-    run=$WORK/s$seed-$r
-    [ -f "$run/eval.json" ] && continue
-    log "single $r seed $seed"
-    "$NERAF" train --modality audio --data "$WORK/$r" --vision-run "$WORK/v-$r" \
-      --steps "$AUDIO_STEPS" --seed "$seed" --threads "$THREADS" --out "$run" --force --quiet
-    "$NERAF" eval --run "$run" --json "$run/eval.json.tmp" --skip-vision --no-images \
-      --threads "$THREADS" --quiet >"$run.eval.txt"
-    mv "$run/eval.json.tmp" "$run/eval.json"
+    for kind in short long; do
+      run=$WORK/s$seed-$r steps=$AUDIO_STEPS
+      [ $kind = long ] && run=$WORK/s$seed-$r-long steps=$((3 * AUDIO_STEPS))
+      [ -f "$run/eval.json" ] && continue
+      log "single $r seed $seed, $steps steps"
+      "$NERAF" train --modality audio --data "$WORK/$r" --vision-run "$WORK/v-$r" \
+        --steps "$steps" --seed "$seed" --threads "$THREADS" --out "$run" --force --quiet
+      "$NERAF" eval --run "$run" --json "$run/eval.json.tmp" --skip-vision --no-images \
+        --threads "$THREADS" --quiet >"$run.eval.txt"
+      mv "$run/eval.json.tmp" "$run/eval.json"
+    done
   done
   for grid in sampled zeros none; do
     run=$WORK/m$seed-$grid
@@ -111,12 +116,17 @@ for seed in seeds:
     ms = json.load(open(f"{work}/m{seed}-sampled/eval.json"))["audio"]
     entry = {"rooms": {}, "multi_mean": ms["mean"]}
     single_means = {m: 0.0 for m in METRICS}
+    long_means = {m: 0.0 for m in METRICS}
     for r in rooms:
         single = json.load(open(f"{work}/s{seed}-{r}/eval.json"))["audio"]
         mcsv = f"{work}/m{seed}-sampled/eval/{r}/audio_per_rir.csv"
         scsv = f"{work}/s{seed}-{r}/eval/audio_per_rir.csv"
         multi = per_rir(mcsv, "neraf")
+        long = json.load(open(f"{work}/s{seed}-{r}-long/eval.json"))["audio"]
+        lcsv = f"{work}/s{seed}-{r}-long/eval/audio_per_rir.csv"
         room = {"single": {k: single[k] for k in ("neraf", "linear", "nearest") if k in single},
+                "single_long": {k: long[k] for k in ("neraf", "linear") if k in long},
+                "paired_multi_minus_single_long": paired(multi, per_rir(lcsv, "neraf")),
                 "multi": {k: ms["scenes"][r][k] for k in ("neraf", "linear", "nearest")},
                 "multi_grid_zeros": ms["scenes"][r]["ablations"]["m%s-zeros" % seed],
                 "multi_grid_none": ms["scenes"][r]["ablations"]["m%s-none" % seed],
@@ -124,9 +134,12 @@ for seed in seeds:
                 "paired_multi_minus_zeros": paired(multi, per_rir(mcsv, "m%s-zeros" % seed)),
                 "paired_multi_minus_none": paired(multi, per_rir(mcsv, "m%s-none" % seed)),
                 "paired_multi_minus_linear": paired(multi, per_rir(mcsv, "linear"))}
-        for m in METRICS: single_means[m] += single["neraf"][m] / len(rooms)
+        for m in METRICS:
+            single_means[m] += single["neraf"][m] / len(rooms)
+            long_means[m] += long["neraf"][m] / len(rooms)
         entry["rooms"][r] = room
     entry["single_mean"] = single_means
+    entry["single_long_mean"] = long_means
     out["seeds"][seed] = entry
 with open(result + ".tmp", "w") as f:
     json.dump(out, f, indent=1)
@@ -135,11 +148,13 @@ os.replace(result + ".tmp", result)
 for seed, e in out["seeds"].items():
     print(f"seed {seed}: T60 % / C50 dB / EDT s / STFT  (lower is better)")
     for r, x in e["rooms"].items():
-        for name, v in (("single", x["single"]["neraf"]), ("multi", x["multi"]["neraf"]),
+        for name, v in (("single", x["single"]["neraf"]),
+                        ("single long", x["single_long"]["neraf"]), ("multi", x["multi"]["neraf"]),
                         ("multi zeros", x["multi_grid_zeros"]), ("multi none", x["multi_grid_none"]),
                         ("linear", x["multi"]["linear"])):
             print(f"  {r:11s} {name:12s} " + "  ".join(f"{v[m]:.4g}" for m in METRICS))
-        for name in ("paired_multi_minus_single", "paired_multi_minus_zeros", "paired_multi_minus_none"):
+        for name in ("paired_multi_minus_single", "paired_multi_minus_single_long",
+                     "paired_multi_minus_zeros", "paired_multi_minus_none"):
             p = x[name]
             print(f"  {r:11s} {name:26s} " + "  ".join(
                 f"{p[m]['mean_difference']:+.4g}±{(p[m]['standard_error'] or float('nan')):.2g}" for m in METRICS))
