@@ -168,7 +168,7 @@ TEST(ResolveTrainConfig, AudioStartStepMovesAWarmupThatEndedThere) {
 
 TEST(ResolveTrainConfig, VisionRunOnlyWithAudioAndAbsolute) {
   TrainFlags f;
-  f.vision_run = "runs/../runs/vision";
+  f.vision_runs = {"runs/../runs/vision"};
   for (Modality m : {Modality::vision, Modality::joint}) {
     try {
       resolve("cpu", m, f);
@@ -181,6 +181,21 @@ TEST(ResolveTrainConfig, VisionRunOnlyWithAudioAndAbsolute) {
   EXPECT_EQ(c.audio.vision_run,
             (std::filesystem::current_path() / "runs" / "vision").lexically_normal().string());
   EXPECT_TRUE(resolve("cpu", Modality::audio).audio.vision_run.empty());
+  EXPECT_TRUE(c.audio.vision_runs.empty());  // one scene: the single-scene config, unchanged
+  EXPECT_EQ(num_scenes(c), 1);
+  // Two --vision-run: a multi-scene run, every run absolute, the first also audio.vision_run.
+  f.vision_runs.push_back("runs/b");
+  const TrainConfig multi = resolve("cpu", Modality::audio, f);
+  ASSERT_EQ(multi.audio.vision_runs.size(), 2u);
+  EXPECT_EQ(multi.audio.vision_runs[0], c.audio.vision_run);
+  EXPECT_EQ(multi.audio.vision_run, c.audio.vision_run);
+  EXPECT_EQ(multi.audio.vision_runs[1],
+            (std::filesystem::current_path() / "runs" / "b").lexically_normal().string());
+  EXPECT_EQ(num_scenes(multi), 2);
+  validate(multi, "config");
+  TrainConfig joint = multi;
+  joint.modality = Modality::joint;
+  EXPECT_THROW(validate(joint, "config"), Error);  // joint multi-scene is refused
 }
 
 // `reference` is the published model exactly: paper's sizes and schedule, no calibration, no

@@ -6,6 +6,10 @@
 #include <gtest/gtest.h>
 #include <torch/torch.h>
 
+#include <cmath>
+#include <memory>
+#include <vector>
+
 #include "../infer/audio_test_util.h"
 #include "neraf/infer/checkpoint.h"
 #include "neraf/train/trainer.h"
@@ -116,6 +120,58 @@ TEST(AudioBranch, MismatchedDatasetOrPresetIsAClearError) {
   TrainConfig paper = c;
   paper.preset = "paper";
   EXPECT_THROW(infer::check_checkpoint_header(arch, paper, path), Error);
+}
+
+// Multi-scene: two rooms (the second with one point moved, so its box and RIRs differ), each with
+// its own frozen field and grid, one acoustic model; a batch mixes both; the checkpoint resumes
+// exactly and is refused by a one-scene branch.
+TEST(AudioBranch, MultiSceneStepsOverBothScenesAndResumesExactly) {
+  torch::manual_seed(0);
+  const std::string dir = make_temp_dir("multi");
+  const data::RirSet a = tiny_rir_set(dir + "/a");
+  const data::RirSet b = tiny_rir_set(dir + "/b", /*move_a_point=*/true);
+  TrainConfig c = tiny_joint_config();
+  c.modality = infer::Modality::audio;
+  auto make = [&](uint64_t field_seed) {
+    auto t = std::make_unique<Trainer>(c, torch::kCPU);
+    std::vector<nerf::NerfactoModel> fields;
+    for (uint64_t k = 0; k < 2; ++k) {
+      fields.emplace_back(c.model, 4, field_seed + k);  // two different frozen fields
+      for (auto& p : fields.back()->parameters()) p.set_requires_grad(false);
+    }
+    t->add_branch(std::make_unique<AudioBranch>(c, std::vector<const data::RirSet*>{&a, &b}, fields,
+                                                /*frozen_field=*/true, torch::kCPU));
+    return t;
+  };
+  auto t = make(7);
+  auto* audio = dynamic_cast<AudioBranch*>(t->branch("audio"));
+  ASSERT_EQ(audio->num_scenes(), 2u);
+  // Each scene's grid is filled from its own field.
+  EXPECT_FALSE(torch::equal(audio->grid(0)->grid(), audio->grid(1)->grid()));
+  EXPECT_EQ(audio->train_rirs(1).size(), b.train.size());
+  for (int i = 0; i < 2; ++i) {
+    const StepResult r = t->step();
+    EXPECT_GT(r.losses.at("audio_mag_loss"), 0.0);
+    EXPECT_TRUE(std::isfinite(r.losses.at("audio_sc_loss")));
+  }
+  const std::string path = dir + "/multi.pt";
+  t->save_checkpoint(path);
+  torch::manual_seed(99);
+  auto u = make(7);
+  u->load_checkpoint(path);
+  const StepResult ra = t->step(), rb = u->step();
+  EXPECT_DOUBLE_EQ(ra.losses.at("audio_mag_loss"), rb.losses.at("audio_mag_loss"));
+  EXPECT_DOUBLE_EQ(ra.losses.at("audio_sc_loss"), rb.losses.at("audio_sc_loss"));
+  // A one-scene branch refuses the two-scene checkpoint, naming the count.
+  auto one = std::make_unique<Trainer>(c, torch::kCPU);
+  one->add_branch(std::make_unique<AudioBranch>(c, a, nerf::NerfactoModel(c.model, 4, 7),
+                                                /*frozen_field=*/true, torch::kCPU));
+  try {
+    one->load_checkpoint(path);
+    FAIL() << "expected neraf::Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("trained on 2 scene(s)"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

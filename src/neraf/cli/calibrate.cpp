@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "neraf/cli/commands.h"
 #include "neraf/data/rir_set.h"
@@ -30,7 +31,8 @@ void run_calibrate(const CalibrateArgs& args) {
   const io::FolderLock lock(args.run_dir);  // not while training writes the run
   const std::string manifest_path = args.run_dir + "/data.json";
   const nlohmann::json manifest = io::read_json(manifest_path);
-  require(manifest.contains("audio") && manifest.contains("data"),
+  const bool multi = infer::is_multiscene(manifest);
+  require(multi || (manifest.contains("audio") && manifest.contains("data")),
           manifest_path + ": no audio dataset in this run (trained with --modality vision)");
   data::RirLoadOptions load;
   load.progress = !args.quiet;
@@ -42,9 +44,23 @@ void run_calibrate(const CalibrateArgs& args) {
   load.half_precision = data::parse_cache_precision(
       args.cache_precision.empty() ? cfg.audio.cache_precision : args.cache_precision);
   load.max_len = cfg.audio.max_len;  // as training loaded it (0: automatic)
-  const std::string data_dir = args.data.empty() ? manifest["data"].get<std::string>() : args.data;
-  const data::RirSet rirs = data::load_rir_set(data_dir, load);
-  const std::string path = infer::calibrate_run(args.run_dir, rirs, args.checkpoint);
+  std::string path;
+  if (multi) {
+    // Every scene from the dataset its manifest records (one calibration file holds them all).
+    require(args.data.empty(),
+            "--data: a multi-scene run records each scene's dataset; drop --data");
+    std::vector<data::RirSet> sets;
+    for (const auto& scene : manifest["scenes"])
+      sets.push_back(data::load_rir_set(scene.value("data", std::string()), load));
+    std::vector<const data::RirSet*> scenes;
+    for (const auto& r : sets) scenes.push_back(&r);
+    path = infer::calibrate_run(args.run_dir, scenes, args.checkpoint);
+  } else {
+    const std::string data_dir =
+        args.data.empty() ? manifest["data"].get<std::string>() : args.data;
+    const data::RirSet rirs = data::load_rir_set(data_dir, load);
+    path = infer::calibrate_run(args.run_dir, rirs, args.checkpoint);
+  }
   std::printf("wrote %s\n", path.c_str());
 }
 

@@ -189,6 +189,8 @@ struct EvalField {
   const infer::AudioField* uncalibrated = nullptr;
   // --run only (nullptr for --model): the run, which the ablation runs must have trained like.
   const infer::AudioRun* run = nullptr;
+  // A multi-scene run: the scene scored (the ablation runs are loaded at the same scene); −1 else.
+  int64_t scene = -1;
 };
 
 // Refuses an ablation run whose training differs from the main run's in anything but the
@@ -245,7 +247,8 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
                 "' (each is labelled by its folder's name); give each its own folder name");
     ablations.push_back(
         {dir, label,
-         infer::load_audio_run(dir, torch::kCPU, "", nerf::parse_precision(args.precision))});
+         infer::load_audio_run(dir, torch::kCPU, "", nerf::parse_precision(args.precision),
+                               /*calibrated=*/true, source.scene)});
     infer::check_audio_manifest(ablations.back().run.run().manifest.at("audio"), rirs,
                                 dir + "/data.json");
     check_trained_alike(*source.run, args.run, ablations.back().run, dir);
@@ -292,6 +295,74 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
     out["novel"]["data"] = args.novel_data;
   }
   return out;
+}
+
+// The mean over scenes (each scene counts once, as the paper's table averages its rooms) of
+// every method's metrics and of every paired difference; n_rirs is the total.
+nlohmann::json mean_over_scenes(const std::vector<nlohmann::json>& scenes) {
+  nlohmann::json mean = nlohmann::json::object();
+  const double n = static_cast<double>(scenes.size());
+  auto average = [&](auto&& get) {  // get(scene) → the json number or null
+    double sum = 0;
+    for (const nlohmann::json& s : scenes) {
+      const nlohmann::json v = get(s);
+      if (!v.is_number()) return nlohmann::json();
+      sum += v.get<double>();
+    }
+    return nlohmann::json(sum / n);
+  };
+  const char* metrics[] = {"t60_error_pct", "c50_error_db", "edt_error_s", "stft_error",
+                           "invalid_t60"};
+  std::vector<std::pair<std::string, std::string>> methods;  // (group, method); group "" = top
+  for (const auto& [k, v] : scenes.front().items())
+    if (v.is_object() && v.contains("t60_error_pct")) methods.push_back({"", k});
+  if (scenes.front().contains("ablations"))
+    for (const auto& [k, v] : scenes.front()["ablations"].items())
+      methods.push_back({"ablations", k});
+  for (const auto& [group, name] : methods) {
+    nlohmann::json m;
+    int64_t count = 0;
+    for (const nlohmann::json& s : scenes) {
+      const nlohmann::json& x = group.empty() ? s : s[group];
+      count += x.contains(name) ? x[name].value("n_rirs", int64_t{0}) : 0;
+    }
+    m["n_rirs"] = count;
+    for (const char* key : metrics)
+      m[key] = average([&](const nlohmann::json& s) {
+        const nlohmann::json& x = group.empty() ? s : s[group];
+        return x.contains(name) ? x[name].value(key, nlohmann::json()) : nlohmann::json();
+      });
+    (group.empty() ? mean[name] : mean[group][name]) = m;
+  }
+  // Paired differences: the mean of the per-scene means; its standard error from the scenes'
+  // (independent sets of RIRs): sqrt(Σ se²)/N.
+  for (const char* group : {"paired", "paired_uncalibrated", "paired_ablations"}) {
+    if (!scenes.front().contains(group)) continue;
+    for (const auto& [other, per_metric] : scenes.front()[group].items())
+      for (const auto& [key, unused] : per_metric.items()) {
+        double sum = 0, var = 0;
+        int64_t count = 0;
+        bool ok = true;
+        for (const nlohmann::json& s : scenes) {
+          const nlohmann::json d =
+              s.contains(group) && s[group].contains(other) && s[group][other].contains(key)
+                  ? s[group][other][key]
+                  : nlohmann::json();
+          if (!d.is_object() || !d["mean_difference"].is_number() ||
+              !d["standard_error"].is_number()) {
+            ok = false;
+            break;
+          }
+          sum += d["mean_difference"].get<double>();
+          var += std::pow(d["standard_error"].get<double>(), 2);
+          count += d.value("n", int64_t{0});
+        }
+        if (!ok) continue;
+        mean[group][other][key] = {
+            {"mean_difference", sum / n}, {"standard_error", std::sqrt(var) / n}, {"n", count}};
+      }
+  }
+  return mean;
 }
 
 nlohmann::json evaluate_vision_json(infer::LoadedRun& run, const EvalArgs& args,
@@ -347,6 +418,10 @@ void register_eval(CLI::App& app) {
       "prediction | GT log-STFT) and audio_per_rir.csv go to RUN/eval/ (or --images DIR).\n"
       "The test split holds out (source, heading) pairs at trained microphone positions;\n"
       "--novel-data scores new positions too (audio.novel).\n"
+      "A multi-scene run (neraf train with several --data) is scored scene by scene on each\n"
+      "scene's test split (audio.scenes.NAME; PNGs and CSVs in RUN/eval/NAME/) and as the mean\n"
+      "over scenes, each counting once (audio.mean); --ablation-runs must be multi-scene runs\n"
+      "of the same scenes.\n"
       "With --model (neraf export) only the audio is scored; PNGs and CSVs go to\n"
       "MODEL_eval/ (or --images DIR).\n"
       "Example: neraf eval --run runs/demo --json runs/demo/eval.json");
@@ -417,6 +492,11 @@ void register_eval(CLI::App& app) {
           meta.value("grid", std::string("sampled")),
           {},
           meta.value("calibration", false) ? eval::kCalibratedGriffinLim : eval::kGriffinLim};
+      // Frames per RIR as training loaded them, when they were set (--max-len, or a multi-scene
+      // run's common value) rather than automatic.
+      const nlohmann::json& audio = meta["data"]["audio"];
+      if (audio.value("max_len_source", std::string()) == "--max-len")
+        source.cache.max_len = audio.value("max_len", int64_t{0});
       nlohmann::json out = {{"model", args->model},
                             {"run", meta.value("run", std::string())},
                             {"checkpoint", meta.value("checkpoint", std::string())},
@@ -447,6 +527,81 @@ void register_eval(CLI::App& app) {
         shown,
         [&](const std::string& tmp) {
           const OutputDir dir{tmp, shown};
+          if (!cfg.audio.vision_runs.empty()) {
+            // Multi-scene: every scene scored on its own test split (its PNGs and CSVs in a
+            // folder named after it), then the mean over scenes.
+            require(args->data.empty(),
+                    "--data: a multi-scene run records each scene's dataset; drop --data");
+            require(args->novel_data.empty(),
+                    "--novel-data: not available for a multi-scene run (it names one room); "
+                    "export or render one --scene instead");
+            const nlohmann::json manifest =
+                io::read_json((std::filesystem::path(args->run) / "data.json").string());
+            const std::vector<std::string> names = infer::scene_names(manifest);
+            require(names.size() == cfg.audio.vision_runs.size(),
+                    args->run + "/data.json: does not list the run's scenes; re-run neraf train");
+            nlohmann::json audio = {{"scenes", nlohmann::json::object()}, {"scene_order", names}};
+            std::vector<nlohmann::json> per_scene;
+            for (size_t k = 0; k < names.size(); ++k) {
+              const int64_t scene = static_cast<int64_t>(k);
+              const infer::AudioRun run =
+                  infer::load_audio_run(args->run, torch::kCPU, args->checkpoint,
+                                        nerf::parse_precision(args->precision), true, scene);
+              std::optional<infer::AudioRun> uncalibrated;
+              if (run.calibration().defined())
+                uncalibrated =
+                    infer::load_audio_run(args->run, torch::kCPU, args->checkpoint,
+                                          nerf::parse_precision(args->precision), false, scene);
+              const EvalField source{
+                  run,
+                  run.run().manifest,
+                  run.run().config.seed,
+                  run.run().config.audio.fraction,
+                  run.run().config.audio.grid,
+                  {run.run().config.audio.cache_dir, run.run().config.audio.cache_precision,
+                   run.run().config.audio.max_len},
+                  post_processing_of(run),
+                  uncalibrated ? &*uncalibrated : nullptr,
+                  &run,
+                  scene};
+              const OutputDir sub{(std::filesystem::path(tmp) / names[k]).string(),
+                                  (std::filesystem::path(shown) / names[k]).string()};
+              std::filesystem::create_directories(sub.written);
+              std::printf("scene %zu/%zu: %s (%s)\n", k + 1, names.size(), names[k].c_str(),
+                          run.run().manifest.value("data", std::string("?")).c_str());
+              per_scene.push_back(evaluate_audio_json(source, *args, sub));
+              per_scene.back()["data"] = run.run().manifest.value("data", std::string());
+              audio["scenes"][names[k]] = per_scene.back();
+              out["checkpoint"] = run.run().checkpoint;
+              out["step"] = run.step();
+            }
+            audio["mean"] = mean_over_scenes(per_scene);
+            out["precision"] = args->precision;
+            out["audio"] = audio;
+            const nlohmann::json& m = audio["mean"];
+            std::printf("mean over %zu scenes (each scene counts once):\n", names.size());
+            for (const auto& [name, v] : m.items())
+              if (v.contains("t60_error_pct"))
+                std::printf("  %-20s T60 %8.3f %%  C50 %7.3f dB  EDT %8.5f s  STFT %7.4f\n",
+                            name.c_str(),
+                            v["t60_error_pct"].is_number() ? v["t60_error_pct"].get<double>() : NAN,
+                            v["c50_error_db"].is_number() ? v["c50_error_db"].get<double>() : NAN,
+                            v["edt_error_s"].is_number() ? v["edt_error_s"].get<double>() : NAN,
+                            v["stft_error"].is_number() ? v["stft_error"].get<double>() : NAN);
+            if (m.contains("ablations"))
+              for (const auto& [name, v] : m["ablations"].items())
+                std::printf("  %-20s T60 %8.3f %%  C50 %7.3f dB  EDT %8.5f s  STFT %7.4f\n",
+                            name.c_str(),
+                            v["t60_error_pct"].is_number() ? v["t60_error_pct"].get<double>() : NAN,
+                            v["c50_error_db"].is_number() ? v["c50_error_db"].get<double>() : NAN,
+                            v["edt_error_s"].is_number() ? v["edt_error_s"].get<double>() : NAN,
+                            v["stft_error"].is_number() ? v["stft_error"].get<double>() : NAN);
+            if (!args->skip_vision)
+              std::printf(
+                  "vision: not scored for a multi-scene acoustic run (it has no radiance "
+                  "field of its own); eval each scene's --vision-run\n");
+            return;
+          }
           if (cfg.modality != infer::Modality::vision) {
             const infer::AudioRun audio = infer::load_audio_run(
                 args->run, torch::kCPU, args->checkpoint, nerf::parse_precision(args->precision));

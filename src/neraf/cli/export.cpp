@@ -17,10 +17,14 @@ struct ExportArgs {
   std::string out_path;
   std::string precision = "fp32";
   std::string checkpoint;
+  std::string scene;  // a multi-scene run: the scene exported (its grid feature and box)
 };
 
 void run_export(const ExportArgs& args) {
-  const infer::AudioRun run = infer::load_audio_run(args.run_dir, torch::kCPU, args.checkpoint);
+  // An export holds one scene's folded feature and box: a multi-scene run needs --scene.
+  const infer::AudioRun run =
+      infer::load_audio_run(args.run_dir, torch::kCPU, args.checkpoint, nerf::Precision::fp32,
+                            /*calibrated=*/true, infer::scene_flag(args.run_dir, args.scene));
   infer::ExportOptions options;
   options.bf16 = args.precision == "bf16";
   const infer::ExportReport report = infer::export_model(run, args.out_path, options);
@@ -54,6 +58,10 @@ void register_export(CLI::App& app) {
   cmd->add_option("--checkpoint", args->checkpoint,
                   "a checkpoint file of the run (default: the latest)")
       ->check(CLI::ExistingFile);
+  cmd->add_option("--scene", args->scene,
+                  "a multi-scene run (neraf train with several --data): the scene to export, by "
+                  "name (its dataset folder's) or index; required there, as a model file holds "
+                  "one scene");
   cmd->footer(
       "Example:\n  neraf export --run runs/demo --out demo.nrf\n  neraf render rir --model "
       "demo.nrf --mic 2,1.5,1.75 --src 1.1,1.2,0.9 --yaw 90 --out rir.wav");

@@ -244,8 +244,8 @@ void add_render_loudness(CLI::App& render) {
   cmd->callback([args] {
     if (args->threads > 0) torch::set_num_threads(args->threads);
     const geometry::Vec3 src = parse_flag_position(args->pose.src, "--src");
-    require_safe_output({"--out", args->out}, {{"--csv", args->csv}, {"--model", args->field.model}},
-                        args->field.run);
+    require_safe_output({"--out", args->out},
+                        {{"--csv", args->csv}, {"--model", args->field.model}}, args->field.run);
     require_safe_output({"--csv", args->csv}, {{"--model", args->field.model}}, args->field.run);
     const LoadedField field = load_field(args->field);
     const infer::AudioRunInfo& info = field.field->info();
@@ -342,6 +342,10 @@ void add_field_options(CLI::App* cmd, FieldArgs& a, bool poses) {
                   "or bf16 (as a bf16 run trained)")
       ->check(CLI::IsMember({"fp32", "bf16"}))
       ->needs(a.run_opt);
+  cmd->add_option("--scene", a.scene,
+                  "The scene of a multi-scene --run (neraf train with several --data): its name "
+                  "(the dataset folder's) or index")
+      ->needs(a.run_opt);
   if (poses) {
     cmd->add_flag("--allow-outside", a.allow_outside,
                   "Render poses outside the field's training box (train microphones +- 1 m) "
@@ -361,7 +365,8 @@ LoadedField load_field(const FieldArgs& a) {
   }
   if (a.run.empty()) throw CLI::RequiredError("--run or --model");
   auto run = std::make_unique<infer::AudioRun>(infer::load_audio_run(
-      a.run, torch::kCPU, a.checkpoint, nerf::parse_precision(a.precision, "--precision")));
+      a.run, torch::kCPU, a.checkpoint, nerf::parse_precision(a.precision, "--precision"),
+      /*calibrated=*/true, infer::scene_flag(a.run, a.scene)));
   out.step = run->step();
   out.name = a.run;
   out.field = std::move(run);

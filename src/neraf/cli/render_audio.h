@@ -24,13 +24,14 @@ struct FieldArgs {
   std::string model;
   std::string checkpoint;
   std::string precision = "fp32";  // of --run's queries
+  std::string scene;               // --scene NAME|INDEX of a multi-scene --run
   bool allow_outside = false;
   CLI::Option* run_opt = nullptr;
   CLI::Option* model_opt = nullptr;
 };
 
-// --run, --model (exclusive; load_field requires one), --checkpoint and --precision (need --run)
-// and, when
+// --run, --model (exclusive; load_field requires one), --checkpoint, --precision and --scene
+// (need --run) and, when
 // `poses` (the command checks poses against the training box), --allow-outside.
 void add_field_options(CLI::App* cmd, FieldArgs& args, bool poses);
 

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "neraf/cli/commands.h"
 #include "neraf/cli/flag_checks.h"
@@ -23,10 +24,10 @@ namespace neraf::cli {
 namespace {
 
 struct TrainArgs {
-  std::string data;
+  std::vector<std::string> data;  // one per scene (2+ make a multi-scene audio run)
   std::string modality = "joint";
   std::string grid = "sampled";
-  std::string vision_run;
+  std::vector<std::string> vision_run;
   double audio_fraction = 1.0;
   int64_t audio_start = -2;
   double decay_loss = 0;
@@ -101,9 +102,21 @@ void register_train(CLI::App& app) {
       "on the frozen grid of a finished run: --vision-run RUN, the paper's separate training).\n"
       "Presets: cpu (default; minutes on 2 cores for the simulator's demo room) and paper\n"
       "(exact Nerfacto/NeRAF sizes: 16-level 2^19 hash grid, proposal 256/96, 48 samples).\n"
-      "Example: neraf train --data demo/ --out runs/demo");
-  CLI::Option* data = cmd->add_option(
-      "--data", args->data, "Dataset folder (or its transforms.json); optional with --resume");
+      "Multi-scene (the paper's generalisation over rooms): --modality audio with one --data and\n"
+      "one --vision-run per scene, in the same order (each vision run trained on its scene):\n"
+      "one grid per scene from its own radiance field, one scene encoder and acoustic field for\n"
+      "all, batches mixing every scene; the scenes must share layout, sample rate and STFT\n"
+      "(frames per RIR: --max-len, else the longest scene's). Render, export and auralize take\n"
+      "--scene NAME|INDEX (NAME: the dataset folder's name); eval scores every scene and their\n"
+      "mean. Joint multi-scene training is not implemented.\n"
+      "Example: neraf train --data demo/ --out runs/demo\n"
+      "         neraf train --modality audio --data a/ --vision-run runs/a-vision --data b/\n"
+      "           --vision-run runs/b-vision --out runs/ab");
+  CLI::Option* data = cmd->add_option("--data", args->data,
+                                      "Dataset folder (or its transforms.json); optional with "
+                                      "--resume; once per scene for a multi-scene audio run")
+                          ->expected(1)
+                          ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_option("--modality", args->modality,
                   "What to train: joint (images + RIRs), vision (images only) or audio (RIRs on "
                   "the frozen field of --vision-run)")
@@ -155,10 +168,13 @@ void register_train(CLI::App& app) {
                       "RIRs (0 < F <= 1)")
           ->check(real_number(0, 1, true))
           ->capture_default_str();
-  CLI::Option* vision_run = cmd->add_option(
-      "--vision-run", args->vision_run,
-      "With --modality audio: the finished vision (or joint) run whose radiance field fills "
-      "the grid (frozen)");
+  CLI::Option* vision_run =
+      cmd->add_option("--vision-run", args->vision_run,
+                      "With --modality audio: the finished vision (or joint) run whose radiance "
+                      "field fills the grid (frozen); once per --data, in the same order, for a "
+                      "multi-scene run")
+          ->expected(1)
+          ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   CLI::Option* audio_start = cmd->add_option("--audio-start-step", args->audio_start,
                                              "Audio losses start after this step (default: the "
                                              "preset's; cpu 1000, paper and reference 2000; audio "
@@ -233,7 +249,22 @@ void register_train(CLI::App& app) {
     if (args->audio_loss_opt->count()) flags.audio_loss = args->audio_loss;
     if (args->grid_resolution_opt->count()) flags.grid_resolution = args->grid_resolution;
     flags.no_relative_geometry = args->no_relative_geometry;
-    if (vision_run->count()) flags.vision_run = args->vision_run;
+    flags.vision_runs = args->vision_run;
+    require(args->data.size() <= 1 || args->modality == "audio",
+            "--data: given " + std::to_string(args->data.size()) +
+                " times; multi-scene training is implemented for --modality audio only (train "
+                "each scene's vision run first, then one --vision-run per --data)");
+    require(args->vision_run.size() <= 1 || args->vision_run.size() == args->data.size(),
+            "--vision-run: given " + std::to_string(args->vision_run.size()) + " times for " +
+                std::to_string(args->data.size()) +
+                " --data; a multi-scene run needs one --vision-run per --data, in the same order");
+    require(args->data.size() <= 1 || args->vision_run.size() == args->data.size() ||
+                args->modality != "audio",
+            "--data: given " + std::to_string(args->data.size()) + " times but " +
+                std::to_string(args->vision_run.size()) +
+                " --vision-run; a multi-scene run needs one --vision-run per --data, in the "
+                "same order");
+
     infer::TrainConfig cfg = infer::resolve_train_config(flags);
     cfg.audio.cache_dir = args->cache_dir;
     cfg.audio.cache_precision = args->cache_precision;
@@ -243,7 +274,8 @@ void register_train(CLI::App& app) {
       warn("--precision bf16: this CPU has no native bf16 instructions; expect slow training");
 
     train::TrainRunOptions opts;
-    opts.data_dir = args->data;
+    if (args->data.size() == 1) opts.data_dir = args->data.front();
+    if (args->data.size() > 1) opts.scene_data_dirs = args->data;
     opts.run_dir = args->out;
     opts.resume = args->resume;
     opts.force = args->force;

@@ -177,7 +177,8 @@ torch::Tensor AudioRun::predict_log_stft_batch(const torch::Tensor& mic, const t
 }
 
 AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
-                        const std::string& checkpoint, nerf::Precision precision, bool calibrated) {
+                        const std::string& checkpoint, nerf::Precision precision, bool calibrated,
+                        int64_t scene) {
   std::error_code ec;
   const std::string config_path = (fs::path(run_dir) / "config.json").string();
   const std::string manifest_path = (fs::path(run_dir) / "data.json").string();
@@ -194,6 +195,21 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
               ": this run has no acoustic field (trained with --modality vision); train "
               "with --modality joint or audio");
   out.run_.manifest = io::read_json(manifest_path);
+  if (is_multiscene(out.run_.manifest)) {
+    const std::vector<std::string> names = scene_names(out.run_.manifest);
+    std::string list;
+    for (size_t i = 0; i < names.size(); ++i)
+      list += (i ? ", " : "") + std::to_string(i) + " " + names[i];
+    require(scene >= 0, run_dir + ": a multi-scene run (" + std::to_string(names.size()) +
+                            " scenes: " + list + "); pick one with --scene NAME|INDEX");
+    require(scene < static_cast<int64_t>(names.size()),
+            run_dir + ": has no scene " + std::to_string(scene) + " (its scenes: " + list + ")");
+    const nlohmann::json one = out.run_.manifest["scenes"][static_cast<size_t>(scene)];
+    out.run_.manifest = one;
+    out.scene_ = scene;
+  } else {
+    require(scene <= 0, run_dir + ": a one-scene run has no scene " + std::to_string(scene));
+  }
   require(out.run_.manifest.contains("audio"),
           manifest_path + ": no audio manifest; re-run neraf train with --modality joint");
   out.info_ = audio_info_from_manifest(out.run_.manifest["audio"], manifest_path);
@@ -220,14 +236,14 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
     a.read("branch_audio", branch);
     branch.read("model", m);
     load_module(*out.model_, m, out.run_.checkpoint);
-    branch.read("grid", g);
+    branch.read(scene_key("grid", out.scene_), g);
     load_module(*grid, g, out.run_.checkpoint);
     torch::Tensor step;
     a.read("step", step);
     out.run_.step = step.item<int64_t>();
     c10::IValue legacy;  // checkpoints written before the calibration stage held their gains
     if (calibrated && out.run_.config.audio.energy_calibration) {
-      if (auto gains = load_calibration(out.run_.checkpoint, out.run_.step))
+      if (auto gains = load_calibration(out.run_.checkpoint, out.run_.step, out.scene_))
         out.calibration_ = gains->to(device);
       else if (branch.try_read("calibration", legacy))
         out.calibration_ = legacy.toTensor().to(device);

@@ -72,6 +72,9 @@ class AudioRun final : public AudioField {
   const AudioRunInfo& info() const override { return info_; }
   const LoadedRun& run() const { return run_; }
   int64_t step() const { return run_.step; }
+  // The scene this field answers for: 0 for a one-scene run; for a multi-scene run the one
+  // load_audio_run was asked for (run().manifest is then that scene's manifest).
+  int64_t scene() const { return scene_; }
 
   // N poses: mic, src [N, 3] float64 metres, yaw [N] degrees → [N, C, F, T] (no autograd).
   torch::Tensor predict_log_stft_batch(const torch::Tensor& mic, const torch::Tensor& src,
@@ -91,8 +94,9 @@ class AudioRun final : public AudioField {
 
  private:
   friend AudioRun load_audio_run(const std::string&, torch::Device, const std::string&,
-                                 nerf::Precision, bool);
-  LoadedRun run_;  // run_.model is the radiance field (nullptr-free only for vision/joint runs)
+                                 nerf::Precision, bool, int64_t);
+  LoadedRun run_;
+  int64_t scene_ = 0;  // run_.model is the radiance field (nullptr-free only for vision/joint runs)
   AudioRunInfo info_;
   acoustic::AcousticModel model_{nullptr};  // eval mode from load on; queries only read it
   torch::Tensor feature_;  // [G] scene feature (eval-mode ResNet3D on the saved grid) or undefined
@@ -104,9 +108,11 @@ class AudioRun final : public AudioField {
 // on machines with native bf16) and apply the checkpoint's energy calibration (calibration.h)
 // when `calibrated` and the run has one (a warning when the run uses calibration but this step
 // was never calibrated). neraf::Error when the run has no acoustic branch (modality vision) or
-// is broken.
+// is broken. A multi-scene run (run.h, is_multiscene) needs `scene` (0..N−1: that scene's grid,
+// box, calibration and manifest; see find_scene); −1 on it is refused naming --scene.
 AudioRun load_audio_run(const std::string& run_dir, torch::Device device = torch::kCPU,
                         const std::string& checkpoint = "",
-                        nerf::Precision precision = nerf::Precision::fp32, bool calibrated = true);
+                        nerf::Precision precision = nerf::Precision::fp32, bool calibrated = true,
+                        int64_t scene = -1);
 
 }  // namespace neraf::infer

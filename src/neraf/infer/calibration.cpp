@@ -66,13 +66,21 @@ torch::Tensor fit_calibration(const AudioRun& run, const data::RirSet& rirs) {
 }
 
 void save_calibration(const std::string& checkpoint, int64_t step, const torch::Tensor& gains) {
+  save_calibration(checkpoint, step, std::vector<torch::Tensor>{gains});
+}
+
+void save_calibration(const std::string& checkpoint, int64_t step,
+                      const std::vector<torch::Tensor>& scene_gains) {
   torch::serialize::OutputArchive a;
   a.write("step", torch::tensor(step, torch::kInt64));
-  a.write("gains", gains.to(torch::kCPU, torch::kFloat32).contiguous());
+  for (size_t s = 0; s < scene_gains.size(); ++s)
+    a.write(scene_key("gains", static_cast<int64_t>(s)),
+            scene_gains[s].to(torch::kCPU, torch::kFloat32).contiguous());
   save_archive(a, calibration_path(checkpoint));
 }
 
-std::optional<torch::Tensor> load_calibration(const std::string& checkpoint, int64_t step) {
+std::optional<torch::Tensor> load_calibration(const std::string& checkpoint, int64_t step,
+                                              int64_t scene) {
   const std::string path = calibration_path(checkpoint);
   std::error_code ec;
   if (!fs::exists(path, ec)) return std::nullopt;
@@ -81,7 +89,7 @@ std::optional<torch::Tensor> load_calibration(const std::string& checkpoint, int
   torch::Tensor stored_step, gains;
   try {
     a.read("step", stored_step);
-    a.read("gains", gains);
+    a.read(scene_key("gains", scene), gains);
   } catch (const c10::Error&) {
     throw Error(path + ": not a calibration file; delete it and run neraf calibrate");
   }
@@ -95,11 +103,27 @@ std::optional<torch::Tensor> load_calibration(const std::string& checkpoint, int
 
 std::string calibrate_run(const std::string& run_dir, const data::RirSet& rirs,
                           const std::string& checkpoint) {
-  const AudioRun run = load_audio_run(run_dir, torch::kCPU, checkpoint, nerf::Precision::fp32,
-                                      /*calibrated=*/false);
-  check_audio_manifest(run.run().manifest["audio"], rirs, run_dir + "/data.json");
-  save_calibration(run.run().checkpoint, run.step(), fit_calibration(run, rirs));
-  return calibration_path(run.run().checkpoint);
+  return calibrate_run(run_dir, std::vector<const data::RirSet*>{&rirs}, checkpoint);
+}
+
+std::string calibrate_run(const std::string& run_dir,
+                          const std::vector<const data::RirSet*>& scenes,
+                          const std::string& checkpoint) {
+  std::vector<torch::Tensor> gains;
+  std::string written, step_checkpoint;
+  int64_t step = 0;
+  for (size_t s = 0; s < scenes.size(); ++s) {
+    // A one-scene run is loaded as such (scene −1); scene s of a multi-scene run by its index.
+    const AudioRun run =
+        load_audio_run(run_dir, torch::kCPU, checkpoint, nerf::Precision::fp32,
+                       /*calibrated=*/false, scenes.size() > 1 ? static_cast<int64_t>(s) : -1);
+    check_audio_manifest(run.run().manifest["audio"], *scenes[s], run_dir + "/data.json");
+    gains.push_back(fit_calibration(run, *scenes[s]));
+    step_checkpoint = run.run().checkpoint;
+    step = run.step();
+  }
+  save_calibration(step_checkpoint, step, gains);
+  return calibration_path(step_checkpoint);
 }
 
 }  // namespace neraf::infer

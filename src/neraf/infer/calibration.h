@@ -8,6 +8,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "neraf/data/rir_set.h"
 #include "neraf/infer/audio_run.h"
@@ -19,14 +20,22 @@ namespace neraf::infer {
 // through Griffin-Lim for the balance); all ones when the run has calibration off.
 torch::Tensor fit_calibration(const AudioRun& run, const data::RirSet& rirs);
 
+// One file per checkpoint; a multi-scene run's holds every scene's gains ("gains", "gains_1", ...).
 void save_calibration(const std::string& checkpoint, int64_t step, const torch::Tensor& gains);
-// The gains saved for `checkpoint` (nullopt when there are none); neraf::Error naming the file
-// when it is damaged or was fitted for another step.
-std::optional<torch::Tensor> load_calibration(const std::string& checkpoint, int64_t step);
+void save_calibration(const std::string& checkpoint, int64_t step,
+                      const std::vector<torch::Tensor>& scene_gains);
+// The gains saved for `checkpoint` (of `scene`; nullopt when there are none); neraf::Error naming
+// the file when it is damaged or was fitted for another step.
+std::optional<torch::Tensor> load_calibration(const std::string& checkpoint, int64_t step,
+                                              int64_t scene = 0);
 
 // Fits and saves the calibration of RUN's latest checkpoint (or `checkpoint`) on `rirs` (the
-// run's dataset); returns the calibration file written.
+// run's dataset); returns the calibration file written. A multi-scene run: one RirSet per scene,
+// in the run's order.
 std::string calibrate_run(const std::string& run_dir, const data::RirSet& rirs,
+                          const std::string& checkpoint = "");
+std::string calibrate_run(const std::string& run_dir,
+                          const std::vector<const data::RirSet*>& scenes,
                           const std::string& checkpoint = "");
 
 }  // namespace neraf::infer

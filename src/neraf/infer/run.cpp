@@ -173,6 +173,65 @@ data::Intrinsics manifest_intrinsics(const nlohmann::json& m, int64_t eval_index
                               "data.json");
 }
 
+bool is_multiscene(const nlohmann::json& m) {
+  return m.is_object() && m.contains("scenes") && m["scenes"].is_array();
+}
+
+std::vector<std::string> scene_names(const nlohmann::json& m) {
+  std::vector<std::string> out;
+  if (!is_multiscene(m)) return out;
+  for (const auto& s : m["scenes"]) out.push_back(s.value("name", std::string("?")));
+  return out;
+}
+
+int64_t find_scene(const nlohmann::json& m, const std::string& selector, const std::string& run_dir,
+                   const std::string& flag) {
+  const std::vector<std::string> names = scene_names(m);
+  std::string list;
+  for (size_t i = 0; i < names.size(); ++i)
+    list += (i ? ", " : "") + std::to_string(i) + " " + names[i];
+  for (size_t i = 0; i < names.size(); ++i)
+    if (names[i] == selector) return static_cast<int64_t>(i);
+  const bool digits = !selector.empty() && selector.size() < 10 &&
+                      selector.find_first_not_of("0123456789") == std::string::npos;
+  if (digits && std::stoll(selector) < static_cast<long long>(names.size()))
+    return std::stoll(selector);
+  throw Error(flag + " " + selector + ": " + run_dir + " has no such scene; its scenes are " +
+              (list.empty() ? std::string("none (it is a one-scene run: drop ") + flag + ")"
+                            : list + " (give a name or an index)"));
+}
+
+int64_t scene_flag(const std::string& run_dir, const std::string& selector,
+                   const std::string& flag) {
+  if (selector.empty()) return -1;
+  const std::string path = run_file(run_dir, "data.json");
+  std::error_code ec;
+  require(
+      fs::is_regular_file(path, ec),
+      run_dir + ": not a training run (no data.json); point --run at a neraf train --out folder");
+  return find_scene(io::read_json(path), selector, run_dir, flag);
+}
+
+std::string scene_key(const std::string& key, int64_t scene) {
+  return scene == 0 ? key : key + "_" + std::to_string(scene);
+}
+
+std::vector<std::string> name_scenes(const std::vector<std::string>& data_dirs) {
+  std::vector<std::string> names;
+  for (const std::string& d : data_dirs) {
+    fs::path p = fs::path(d).lexically_normal();
+    if (p.filename().empty()) p = p.parent_path();
+    if (p.filename() == "transforms.json") p = p.parent_path();
+    names.push_back(p.filename().string());
+  }
+  for (size_t i = 0; i < names.size(); ++i) {
+    bool unique = !names[i].empty();
+    for (size_t j = 0; j < names.size(); ++j) unique = unique && (i == j || names[i] != names[j]);
+    if (!unique) names[i] = "scene" + std::to_string(i);
+  }
+  return names;
+}
+
 LoadedRun load_run(const std::string& run_dir, torch::Device device,
                    const std::string& checkpoint) {
   std::error_code ec;
@@ -187,6 +246,10 @@ LoadedRun load_run(const std::string& run_dir, torch::Device device,
   run.run_dir = run_dir;
   run.config = train_config_from_json(io::read_json(config_path), config_path);
   run.manifest = io::read_json(manifest_path);
+  require(!is_multiscene(run.manifest),
+          run_dir +
+              ": a multi-scene acoustic run has no radiance field of its own; use its "
+              "scenes' vision runs (audio.vision_runs in its config.json)");
   require(run.manifest.value("format", "") == kManifestFormat && run.manifest.contains("num_train"),
           manifest_path + ": not a neraf run data manifest; re-run neraf train");
   if (checkpoint.empty()) {

@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "neraf/data/image_set.h"
 #include "neraf/infer/train_config.h"
@@ -26,6 +27,25 @@ nlohmann::json make_data_manifest(const data::ImageSet& images, const std::strin
 // another world normalisation. A frozen radiance field only describes the room it was trained
 // on; an audio run on another room's grid trains without complaint and learns nothing useful.
 void check_vision_run_data(const std::string& vision_run, const nlohmann::json& data_manifest);
+
+// Multi-scene runs (neraf train with 2+ --data, modality audio): RUN/data.json is
+// {"format", "scenes": [M_0, M_1, ...]}, each M_s a one-scene manifest (make_data_manifest of the
+// scene, with its "audio" entry) plus its "name" (the dataset folder's name, or "scene<s>" when
+// two folders share one). A loaded scene of such a run (load_audio_run with a scene) carries M_s
+// as its manifest, so everything downstream sees an ordinary one-scene run.
+bool is_multiscene(const nlohmann::json& data_manifest);
+std::vector<std::string> scene_names(const nlohmann::json& data_manifest);  // {} for one scene
+// The scene `selector` names (its name, or its index 0..N−1) in a multi-scene manifest;
+// neraf::Error naming `run_dir`, `flag` and the scenes when there is none.
+int64_t find_scene(const nlohmann::json& data_manifest, const std::string& selector,
+                   const std::string& run_dir, const std::string& flag = "--scene");
+// `--scene` of a command on RUN: −1 when `selector` is empty, else find_scene on RUN/data.json.
+int64_t scene_flag(const std::string& run_dir, const std::string& selector,
+                   const std::string& flag = "--scene");
+// Checkpoint key of scene s: `key` for scene 0 (as a one-scene run writes it), else key_s.
+std::string scene_key(const std::string& key, int64_t scene);
+// Names for scenes from their dataset folders: the folder's name, unless two share it.
+std::vector<std::string> name_scenes(const std::vector<std::string>& data_dirs);
 
 // A trained run, ready for rendering (model in eval mode on `device`).
 struct LoadedRun {

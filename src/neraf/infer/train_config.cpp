@@ -135,14 +135,22 @@ TrainConfig resolve_train_config(const TrainFlags& f) {
   if (f.grid_resolution) cfg.audio.grid_resolution = *f.grid_resolution;
   cfg.audio.fraction = f.audio_fraction;
   if (f.no_relative_geometry) cfg.audio.relative_geometry = false;
-  require(cfg.modality == Modality::audio || !f.vision_run,
+  require(cfg.modality == Modality::audio || f.vision_runs.empty(),
           "--vision-run: only used with --modality audio");
-  if (f.vision_run)
-    cfg.audio.vision_run = std::filesystem::absolute(*f.vision_run).lexically_normal().string();
+  auto absolute = [](const std::string& p) {
+    return std::filesystem::absolute(p).lexically_normal().string();
+  };
+  if (!f.vision_runs.empty()) cfg.audio.vision_run = absolute(f.vision_runs.front());
+  if (f.vision_runs.size() > 1)
+    for (const std::string& r : f.vision_runs) cfg.audio.vision_runs.push_back(absolute(r));
   if (f.threads) cfg.threads = *f.threads;
   if (f.rays) cfg.rays_per_batch = *f.rays;
   if (f.precision) cfg.model.precision = *f.precision;
   return cfg;
+}
+
+int64_t num_scenes(const TrainConfig& c) {
+  return std::max<int64_t>(1, static_cast<int64_t>(c.audio.vision_runs.size()));
 }
 
 nlohmann::json to_json(const TrainConfig& c) { return nerf::config_to_json(c); }
@@ -218,6 +226,16 @@ void validate(const TrainConfig& c, const std::string& where) {
     require(!a.vision_run.empty(), where +
                                        ".audio.vision_run: required with --modality audio "
                                        "(--vision-run)");
+  if (!a.vision_runs.empty()) {
+    require(c.modality == Modality::audio,
+            where +
+                ".audio.vision_runs: a multi-scene run trains --modality audio (on each "
+                "scene's frozen vision run); joint multi-scene training is not implemented");
+    require(a.vision_runs.size() >= 2 && a.vision_runs.front() == a.vision_run,
+            where +
+                ".audio.vision_runs: needs 2 or more runs, the first equal to "
+                "audio.vision_run (one --vision-run per --data)");
+  }
   if (c.modality != Modality::vision)
     require(a.start_step < c.steps, where + ".audio.start_step: audio starts after step " +
                                         std::to_string(a.start_step) + " but the run has only " +

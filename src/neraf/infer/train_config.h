@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "neraf/nerf/config.h"
 
@@ -80,6 +81,9 @@ struct AudioConfig {
   // "running" (the reference: running statistics in eval mode; acoustic/resnet3d.h).
   std::string resnet_batch_norm = "grid";
   std::string vision_run;  // modality audio: the finished vision run whose field is frozen
+  // Multi-scene (modality audio with 2+ --data): each scene's vision run, in --data order
+  // (vision_run is the first). Empty for a one-scene run, which is the case N = 1 of the same code.
+  std::vector<std::string> vision_runs;
   // The RIR feature cache (data::RirLoadOptions): its folder ("" = <dataset>/.neraf_cache,
   // --cache-dir) and precision ("fp32", or "fp16": half the disk, features rounded to ~1e-3
   // relative; --cache-precision). Recorded so resume, calibration and eval reuse the same cache.
@@ -113,6 +117,7 @@ struct AudioConfig {
     v("view_directions", view_directions);
     v("resnet_batch_norm", resnet_batch_norm);
     v("vision_run", vision_run);
+    v("vision_runs", vision_runs);
     v("cache_dir", cache_dir);
     v("cache_precision", cache_precision);
     v("max_len", max_len);
@@ -183,7 +188,8 @@ struct TrainFlags {
   std::optional<std::string> audio_loss;     // --audio-loss
   std::optional<int64_t> grid_resolution;    // --grid-resolution
   bool no_relative_geometry = false;         // --no-relative-geometry
-  std::optional<std::string> vision_run;     // --vision-run (stored as an absolute path)
+  // --vision-run, once per --data (stored as absolute paths); two or more make a multi-scene run.
+  std::vector<std::string> vision_runs;
 };
 
 // The config a new run trains with: train_preset(flags.preset), then the modality's defaults,
@@ -199,7 +205,8 @@ struct TrainFlags {
 //     ends there (max(0, S)).
 //   - --seed, --grid, --grid-resolution, --audio-fraction, --audio-loss, --decay-loss,
 //     --no-relative-geometry, --threads, --rays, --precision, --vision-run (made absolute)
-//     overwrite their setting.
+//     overwrite their setting; two or more --vision-run fill audio.vision_runs (multi-scene),
+//     the first also audio.vision_run.
 // neraf::Error naming the flag: --vision-run without --modality audio, an unknown preset.
 // The result is not validated here (run_training validates the config it trains).
 TrainConfig resolve_train_config(const TrainFlags& flags);
@@ -207,6 +214,9 @@ TrainConfig resolve_train_config(const TrainFlags& flags);
 nlohmann::json to_json(const TrainConfig& c);
 // Overlays `j` onto a copy of the preset named in j["preset"] (or `cpu`); `where` names the file.
 TrainConfig train_config_from_json(const nlohmann::json& j, const std::string& where);
+
+// The number of scenes a run trains on: audio.vision_runs' size, else 1.
+int64_t num_scenes(const TrainConfig& c);
 
 // Range checks (neraf::Error "<where>.<key>: ...").
 void validate(const TrainConfig& c, const std::string& where);

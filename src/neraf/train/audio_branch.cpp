@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 #include "neraf/acoustic/calibration.h"
 #include "neraf/acoustic/losses.h"
@@ -18,31 +19,57 @@ using infer::TrainConfig;
 
 AudioBranch::AudioBranch(const TrainConfig& config, const data::RirSet& rirs,
                          nerf::NerfactoModel field, bool frozen_field, torch::Device device)
-    : config_(config),
-      rirs_(rirs),
-      field_(std::move(field)),
-      frozen_(frozen_field),
-      device_(device) {
-  require(rirs_.has_features(), "dataset: the RIR features were not loaded");
-  require(!rirs_.train.empty(),
-          "dataset: the audio train split is empty; the acoustic field "
-          "needs training RIRs");
+    : AudioBranch(config, std::vector<const data::RirSet*>{&rirs},
+                  std::vector<nerf::NerfactoModel>{std::move(field)}, frozen_field, device) {}
+
+AudioBranch::AudioBranch(const TrainConfig& config, const std::vector<const data::RirSet*>& scenes,
+                         const std::vector<nerf::NerfactoModel>& fields, bool frozen_field,
+                         torch::Device device)
+    : config_(config), frozen_(frozen_field), device_(device) {
+  TORCH_CHECK(!scenes.empty() && scenes.size() == fields.size(),
+              "AudioBranch: one radiance field per scene");
+  require(scenes.size() == 1 || frozen_,
+          "multi-scene: only --modality audio (each scene's frozen vision run) is implemented");
+  const data::RirSet& first = *scenes.front();
+  for (const data::RirSet* r : scenes) {
+    require(r->has_features(), "dataset: the RIR features were not loaded");
+    require(!r->train.empty(), r->root +
+                                   ": the audio train split is empty; the acoustic field "
+                                   "needs training RIRs");
+    require(
+        r->channels == first.channels && r->n_freq == first.n_freq && r->max_len == first.max_len,
+        r->root + ": its RIRs differ in channels, frequencies or frames from " + first.root +
+            "; one acoustic field needs scenes of one format");
+  }
   const acoustic::AcousticModelOptions opts = infer::audio_model_options(
-      config_, rirs_.channels, rirs_.n_freq, rirs_.max_len, rirs_.audio_aabb);
+      config_, first.channels, first.n_freq, first.max_len, first.audio_aabb);
   model_ = acoustic::AcousticModel(opts);
   model_->to(device_);
-  grid_ = acoustic::GridSampler(opts.grid);
-  grid_->to(device_);
-  train_rirs_ = infer::audio_train_subset(rirs_, config_.audio.fraction, config_.seed);
-  if (frozen_ && opts.grid_mode == acoustic::GridMode::kSampled) {
-    // The paper's separate training: the field is final, so the whole grid is filled once.
-    field_->eval();
-    grid_->refresh_all(field_query());
+  for (size_t s = 0; s < scenes.size(); ++s) {
+    Scene sc;
+    sc.rirs = scenes[s];
+    sc.field = fields[s];
+    sc.grid = acoustic::GridSampler(opts.grid);
+    sc.grid->to(device_);
+    sc.train_rirs = infer::audio_train_subset(*sc.rirs, config_.audio.fraction, config_.seed);
+    sc.offset = n_train_;
+    n_train_ += static_cast<int64_t>(sc.train_rirs.size());
+    // This scene's box (the scene's own pose normalisation and relative-distance scale).
+    sc.nacf = infer::audio_model_options(config_, sc.rirs->channels, sc.rirs->n_freq,
+                                         sc.rirs->max_len, sc.rirs->audio_aabb)
+                  .nacf;
+    sc.nacf.grid_features = model_->options().nacf.grid_features;
+    scenes_.push_back(std::move(sc));
+    if (frozen_ && opts.grid_mode == acoustic::GridMode::kSampled) {
+      // The paper's separate training: the field is final, so the whole grid is filled once.
+      scenes_.back().field->eval();
+      scenes_.back().grid->refresh_all(field_query(s));
+    }
   }
 }
 
-acoustic::FieldQueryFn AudioBranch::field_query() {
-  nerf::NerfactoModel field = field_;
+acoustic::FieldQueryFn AudioBranch::field_query(size_t scene) {
+  nerf::NerfactoModel field = scenes_[scene].field;
   torch::Device device = device_;
   return [field, device](const torch::Tensor& u, const torch::Tensor& dirs) mutable {
     // Appearance of train image 0, as the reference (camera_indices = 0 in training mode).
@@ -56,18 +83,18 @@ std::vector<ParamGroup> AudioBranch::param_groups() {
   std::vector<torch::Tensor> params = model_->parameters();
   // "Backprop on vision too": the reference's audio optimizer also holds the radiance field.
   if (!frozen_)
-    for (auto& p : field_->field_parameters()) params.push_back(p);
+    for (auto& p : scenes_.front().field->field_parameters()) params.push_back(p);
   return {{"audio_fields", params, config_.audio.schedule}};
 }
 
 void AudioBranch::set_training(bool training) {
   model_->train(training);
-  grid_->train(training);
+  for (Scene& sc : scenes_) sc.grid->train(training);
 }
 
 std::pair<torch::Tensor, torch::Tensor> AudioBranch::sample_slices(at::Generator& gen, int64_t D) {
-  const int64_t T = rirs_.max_len;
-  const int64_t n = static_cast<int64_t>(train_rirs_.size()) * T;
+  const int64_t T = scenes_.front().rirs->max_len;
+  const int64_t n = n_train_ * T;
   const int64_t B = config_.audio.batch_size;
   const int64_t B_early = std::llround(config_.audio.early_fraction * static_cast<double>(B));
   const int64_t B_uniform = B - B_early;
@@ -87,10 +114,10 @@ std::pair<torch::Tensor, torch::Tensor> AudioBranch::sample_slices(at::Generator
     cursor_ += take;
   }
   const torch::Tensor slice = torch::tensor(picks, torch::kInt64);
-  torch::Tensor local = torch::div(slice, T, "floor");  // position in train_rirs_
+  torch::Tensor local = torch::div(slice, T, "floor");  // position among all train RIRs
   torch::Tensor frame = slice - local * T;
   // Early share: random train RIRs, frames in [0, early_frames).
-  const int64_t n_rirs = static_cast<int64_t>(train_rirs_.size());
+  const int64_t n_rirs = n_train_;
   if (B_early > 0) {
     local = torch::cat({local, torch::randint(n_rirs, {B_early}, gen, torch::kInt64)});
     frame = torch::cat({frame, torch::randint(std::min(T, config_.audio.early_frames), {B_early},
@@ -102,40 +129,89 @@ std::pair<torch::Tensor, torch::Tensor> AudioBranch::sample_slices(at::Generator
     local = torch::cat({local, whole.repeat_interleave(T)});
     frame = torch::cat({frame, torch::arange(T, torch::kInt64).repeat({D})});
   }
-  return {torch::tensor(train_rirs_, torch::kInt64).index_select(0, local), frame};
+  return {local, frame};
+}
+
+std::pair<torch::Tensor, torch::Tensor> AudioBranch::forward_scenes(const torch::Tensor& pos,
+                                                                    const torch::Tensor& frame,
+                                                                    int64_t B) {
+  const int64_t M = pos.size(0);
+  const int64_t* p = pos.data_ptr<int64_t>();
+  auto scene_of = [&](int64_t g) {
+    size_t s = scenes_.size() - 1;
+    while (scenes_[s].offset > g) --s;
+    return s;
+  };
+  // Stable per scene within [0, B) and within [B, M), so the whole RIRs stay frame-ordered.
+  std::vector<torch::Tensor> preds, gts;
+  std::vector<torch::Tensor> features(scenes_.size());
+  using Range = std::pair<int64_t, int64_t>;
+  for (const auto& [lo, hi] : {Range{0, B}, Range{B, M}})
+    for (size_t s = 0; s < scenes_.size(); ++s) {
+      std::vector<int64_t> rows, rirs;
+      for (int64_t j = lo; j < hi; ++j)
+        if (scene_of(p[j]) == s) {
+          rows.push_back(j);
+          rirs.push_back(scenes_[s].train_rirs[static_cast<size_t>(p[j] - scenes_[s].offset)]);
+        }
+      if (rows.empty()) continue;
+      const Scene& sc = scenes_[s];
+      const torch::Tensor rir = torch::tensor(rirs, torch::kInt64);
+      const torch::Tensor f = frame.index_select(0, torch::tensor(rows, torch::kInt64));
+      torch::Tensor gt = torch::empty({rir.size(0), sc.rirs->channels, sc.rirs->n_freq},
+                                      torch::kFloat32);  // [b, C, F]
+      sc.rirs->gather_into(rir, f, gt);
+      if (!features[s].defined() && model_->options().grid_mode != acoustic::GridMode::kNone)
+        features[s] = model_->scene_feature(sc.grid->grid());  // [G], once per scene and step
+      const torch::Tensor mic = sc.rirs->mic_positions.index_select(0, rir);
+      const torch::Tensor src = sc.rirs->source_positions.index_select(0, rir);
+      const torch::Tensor rot = sc.rirs->rots.index_select(0, rir);
+      preds.push_back(model_->field()->forward(
+          acoustic::nacf_input(sc.nacf, features[s], f.to(device_), model_->options().max_len,
+                               mic.to(device_), src.to(device_), rot.to(device_))));
+      gts.push_back(gt.to(device_));
+    }
+  return {torch::cat(preds), torch::cat(gts)};  // [M, C, F] each
 }
 
 LossDict AudioBranch::losses(StepContext& ctx) {
   const bool audio_step = ctx.step > config_.audio.start_step;
   const bool sampled = model_->options().grid_mode == acoustic::GridMode::kSampled;
   if (sampled && !frozen_) {
+    acoustic::GridSampler& grid = scenes_.front().grid;  // joint: one scene
     if (audio_step) {
-      grid_->update(field_query());
+      grid->update(field_query());
     } else {
       // No audio loss this step: the same cell values, without building a graph nobody uses.
       torch::NoGradGuard no_grad;
-      grid_->update(field_query());
+      grid->update(field_query());
     }
   }
   if (!audio_step) return {};
 
-  const int64_t B = config_.audio.batch_size, T = rirs_.max_len;
+  const int64_t B = config_.audio.batch_size, T = scenes_.front().rirs->max_len;
   const double decay_weight = config_.audio.decay_weight;
-  const int64_t D = decay_weight > 0 ? std::min<int64_t>(config_.audio.decay_rirs,
-                                                         static_cast<int64_t>(train_rirs_.size()))
-                                     : 0;
-  const auto [rir, frame] = sample_slices(ctx.gen, D);
-  if (!batch_.defined() || batch_.size(0) != rir.size(0))
-    batch_ = torch::empty({rir.size(0), rirs_.channels, rirs_.n_freq}, torch::kFloat32);
-  rirs_.gather_into(rir, frame, batch_);
-  const torch::Tensor gt = batch_.to(device_);  // [B + D·T, C, F]
-  // Metres: the model normalises them by the audio box for the position encodings and takes the
-  // relative geometry from the metres themselves (nacf_input).
-  const torch::Tensor mic = rirs_.mic_positions.index_select(0, rir);
-  const torch::Tensor src = rirs_.source_positions.index_select(0, rir);
-  const torch::Tensor rot = rirs_.rots.index_select(0, rir);
-  const torch::Tensor pred = model_->forward(grid_->grid(), frame.to(device_), mic.to(device_),
-                                             src.to(device_), rot.to(device_));  // [B + D·T, C, F]
+  const int64_t D = decay_weight > 0 ? std::min<int64_t>(config_.audio.decay_rirs, n_train_) : 0;
+  const auto [pos, frame] = sample_slices(ctx.gen, D);
+  torch::Tensor pred, gt;  // [B + D·T, C, F]
+  if (scenes_.size() == 1) {
+    const Scene& sc = scenes_.front();
+    const data::RirSet& rirs = *sc.rirs;
+    const torch::Tensor rir = torch::tensor(sc.train_rirs, torch::kInt64).index_select(0, pos);
+    if (!batch_.defined() || batch_.size(0) != rir.size(0))
+      batch_ = torch::empty({rir.size(0), rirs.channels, rirs.n_freq}, torch::kFloat32);
+    rirs.gather_into(rir, frame, batch_);
+    gt = batch_.to(device_);  // [B + D·T, C, F]
+    // Metres: the model normalises them by the audio box for the position encodings and takes
+    // the relative geometry from the metres themselves (nacf_input).
+    const torch::Tensor mic = rirs.mic_positions.index_select(0, rir);
+    const torch::Tensor src = rirs.source_positions.index_select(0, rir);
+    const torch::Tensor rot = rirs.rots.index_select(0, rir);
+    pred = model_->forward(sc.grid->grid(), frame.to(device_), mic.to(device_), src.to(device_),
+                           rot.to(device_));  // [B + D·T, C, F]
+  } else {
+    std::tie(pred, gt) = forward_scenes(pos, frame, B);
+  }
   acoustic::AudioLossOptions loss_options;
   loss_options.criterion = *acoustic::parse_audio_criterion(config_.audio.loss);  // validated
   const acoustic::AudioLossTerms terms =
@@ -157,41 +233,64 @@ LossDict AudioBranch::losses(StepContext& ctx) {
 }
 
 void AudioBranch::save(torch::serialize::OutputArchive& archive) {
-  torch::serialize::OutputArchive m, g;
+  torch::serialize::OutputArchive m;
   model_->save(m);
   archive.write("model", m);
-  // The step's backward is done: cut the fresh cells' autograd history so that only values are
-  // serialised (the next update detaches the grid anyway).
-  const_cast<torch::Tensor&>(grid_->grid()).detach_();
-  grid_->save(g);
-  archive.write("grid", g);
+  for (size_t s = 0; s < scenes_.size(); ++s) {
+    // The step's backward is done: cut the fresh cells' autograd history so that only values are
+    // serialised (the next update detaches the grid anyway).
+    const_cast<torch::Tensor&>(scenes_[s].grid->grid()).detach_();
+    torch::serialize::OutputArchive g;
+    scenes_[s].grid->save(g);
+    archive.write(infer::scene_key("grid", s), g);
+  }
   archive.write("perm", perm_.defined() ? perm_ : torch::empty({0}, torch::kInt64));
   archive.write("cursor", torch::tensor(cursor_, torch::kInt64));
-  archive.write("manifest", c10::IValue(infer::make_audio_manifest(rirs_).dump()));
-  archive.write("train_rirs", torch::tensor(train_rirs_, torch::kInt64));
+  for (size_t s = 0; s < scenes_.size(); ++s) {
+    archive.write(infer::scene_key("manifest", s),
+                  c10::IValue(infer::make_audio_manifest(*scenes_[s].rirs).dump()));
+    archive.write(infer::scene_key("train_rirs", s),
+                  torch::tensor(scenes_[s].train_rirs, torch::kInt64));
+  }
+  if (scenes_.size() > 1)
+    archive.write("num_scenes", torch::tensor(static_cast<int64_t>(scenes_.size()), torch::kInt64));
 }
 
 void AudioBranch::load(torch::serialize::InputArchive& archive, const std::string& where) {
-  c10::IValue manifest;
-  require(archive.try_read("manifest", manifest) && manifest.isString(),
-          where + ": checkpoint has no audio data manifest; it was not written by neraf train");
-  infer::check_audio_manifest(nlohmann::json::parse(manifest.toStringRef()), rirs_, where);
-  torch::serialize::InputArchive m, g;
+  torch::Tensor n_scenes;
+  const int64_t stored = archive.try_read("num_scenes", n_scenes) ? n_scenes.item<int64_t>() : 1;
+  require(stored == static_cast<int64_t>(scenes_.size()),
+          where + ": checkpoint was trained on " + std::to_string(stored) +
+              " scene(s), this run has " + std::to_string(scenes_.size()) +
+              "; resume with the run's own --data");
+  for (size_t s = 0; s < scenes_.size(); ++s) {
+    c10::IValue manifest;
+    require(archive.try_read(infer::scene_key("manifest", s), manifest) && manifest.isString(),
+            where + ": checkpoint has no audio data manifest; it was not written by neraf train");
+    infer::check_audio_manifest(nlohmann::json::parse(manifest.toStringRef()), *scenes_[s].rirs,
+                                where);
+  }
+  torch::serialize::InputArchive m;
   archive.read("model", m);
   infer::load_module(*model_, m, where);
   model_->to(device_);
-  archive.read("grid", g);
-  infer::load_module(*grid_, g, where);
-  grid_->to(device_);
-  torch::Tensor perm, cursor, subset;
+  for (size_t s = 0; s < scenes_.size(); ++s) {
+    Scene& sc = scenes_[s];
+    torch::serialize::InputArchive g;
+    archive.read(infer::scene_key("grid", s), g);
+    infer::load_module(*sc.grid, g, where);
+    sc.grid->to(device_);
+    torch::Tensor subset;
+    archive.read(infer::scene_key("train_rirs", s), subset);
+    require(subset.numel() == static_cast<int64_t>(sc.train_rirs.size()) &&
+                std::equal(sc.train_rirs.begin(), sc.train_rirs.end(), subset.data_ptr<int64_t>()),
+            where +
+                ": checkpoint was trained on another subset of the RIRs (--audio-fraction or "
+                "--seed differ); use a new --out folder");
+  }
+  torch::Tensor perm, cursor;
   archive.read("perm", perm);
   archive.read("cursor", cursor);
-  archive.read("train_rirs", subset);
-  require(subset.numel() == static_cast<int64_t>(train_rirs_.size()) &&
-              std::equal(train_rirs_.begin(), train_rirs_.end(), subset.data_ptr<int64_t>()),
-          where +
-              ": checkpoint was trained on another subset of the RIRs (--audio-fraction or "
-              "--seed differ); use a new --out folder");
   perm_ = perm.numel() > 0 ? perm : torch::Tensor();
   cursor_ = cursor.item<int64_t>();
 }

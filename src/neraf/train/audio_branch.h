@@ -15,6 +15,13 @@
 // Modality audio: the radiance field comes from a finished vision run, frozen; the whole grid is
 // filled once from it (no per-step updates).
 //
+// Multi-scene (modality audio, N ≥ 2 scenes; the paper's generalisation over several rooms): one
+// grid per scene, filled from that scene's frozen field, and ONE acoustic model (ResNet3D + NAcF)
+// over all of them. The epoch permutation runs over every scene's (RIR, frame) slices together,
+// so a batch mixes the scenes in proportion to their training RIRs; each scene's slices go
+// through ResNet3D on its own grid and NAcF with positions normalised by its own audio box. One
+// scene (N = 1) is the special case of the same code and draws exactly the same numbers.
+//
 // INFERENCE (render rir / loudness / auralize --run) does not need this class: use
 // infer/audio_run.h (load_audio_run + AudioRun::predict_log_stft); the model options and the
 // few-shot subset a run trains on are there too (audio_model_options, audio_train_subset).
@@ -40,40 +47,61 @@ class AudioBranch : public Branch {
   // filled completely here). `rirs` must have features and outlive the branch.
   AudioBranch(const infer::TrainConfig& config, const data::RirSet& rirs, nerf::NerfactoModel field,
               bool frozen_field, torch::Device device);
+  // Multi-scene: scene s has `scenes[s]` and its frozen field `fields[s]` (N ≥ 1, same sizes;
+  // N ≥ 2 needs frozen fields). The RirSets must share channels, frequencies and frames per RIR.
+  AudioBranch(const infer::TrainConfig& config, const std::vector<const data::RirSet*>& scenes,
+              const std::vector<nerf::NerfactoModel>& fields, bool frozen_field,
+              torch::Device device);
 
   std::string name() const override { return "audio"; }
   std::vector<ParamGroup> param_groups() override;
   LossDict losses(StepContext& ctx) override;
   void set_training(bool training) override;
   // Saves "model" (AcousticModel), "grid" (GridSampler: grid + pointer) and the data sampler
-  // ("perm", "cursor") so a killed run resumes exactly. (The energy calibration is a stage of
-  // its own after training: infer/calibration.h.)
+  // ("perm", "cursor") so a killed run resumes exactly; scene s ≥ 1 of a multi-scene run adds
+  // "grid_s", "manifest_s", "train_rirs_s" and "num_scenes" (infer::scene_key). (The energy
+  // calibration is a stage of its own after training: infer/calibration.h.)
   void save(torch::serialize::OutputArchive& archive) override;
   void load(torch::serialize::InputArchive& archive, const std::string& where) override;
 
   acoustic::AcousticModel& model() { return model_; }
-  acoustic::GridSampler& grid() { return grid_; }
-  const std::vector<int64_t>& train_rirs() const { return train_rirs_; }
-  // The radiance-field query the grid uses (density, rgb at u with train image 0's appearance).
-  acoustic::FieldQueryFn field_query();
+  acoustic::GridSampler& grid(size_t scene = 0) { return scenes_[scene].grid; }
+  const std::vector<int64_t>& train_rirs(size_t scene = 0) const {
+    return scenes_[scene].train_rirs;
+  }
+  size_t num_scenes() const { return scenes_.size(); }
+  // The radiance-field query the grid of `scene` uses (density, rgb at u with train image 0's
+  // appearance).
+  acoustic::FieldQueryFn field_query(size_t scene = 0);
 
  private:
-  // The step's (RIR index, frame) pairs, each [B + D·T] int64: batch_size slices (the uniform
-  // share from the epoch permutation, then the early share), then D whole RIRs for the
+  struct Scene {
+    const data::RirSet* rirs = nullptr;
+    nerf::NerfactoModel field{nullptr};
+    acoustic::GridSampler grid{nullptr};
+    std::vector<int64_t> train_rirs;  // indices into rirs->rirs
+    int64_t offset = 0;               // position of its first train RIR among all scenes'
+    acoustic::NacfOptions nacf;       // the model's NAcF options with this scene's audio box
+  };
+  // The step's (train RIR, frame) pairs, each [B + D·T] int64, the RIR as a position among all
+  // scenes' train RIRs (scene s owns [offset, offset + its count)): batch_size slices (the
+  // uniform share from the epoch permutation, then the early share), then D whole RIRs for the
   // energy-decay loss (D = 0 when it is off).
   std::pair<torch::Tensor, torch::Tensor> sample_slices(at::Generator& gen, int64_t D);
+  // Multi-scene losses' forward: the slices sorted by scene within the batch and the whole-RIR
+  // part (each scene's ResNet3D feature once, NAcF in its box) → {pred, gt}, each [B + D·T, C, F].
+  std::pair<torch::Tensor, torch::Tensor> forward_scenes(const torch::Tensor& pos,
+                                                         const torch::Tensor& frame, int64_t B);
 
   infer::TrainConfig config_;
-  const data::RirSet& rirs_;
-  nerf::NerfactoModel field_;
   bool frozen_;
   torch::Device device_;
   acoustic::AcousticModel model_{nullptr};
-  acoustic::GridSampler grid_{nullptr};
-  std::vector<int64_t> train_rirs_;  // indices into rirs_.rirs
-  torch::Tensor perm_;               // [n_train·max_len] int64: this epoch's slice order
-  int64_t cursor_ = 0;               // next position in perm_
-  torch::Tensor batch_;              // [B + D·T, C, F] float32 gather buffer
+  std::vector<Scene> scenes_;
+  int64_t n_train_ = 0;  // train RIRs of all scenes
+  torch::Tensor perm_;   // [n_train·max_len] int64: this epoch's slice order
+  int64_t cursor_ = 0;   // next position in perm_
+  torch::Tensor batch_;  // [B + D·T, C, F] float32 gather buffer
 };
 
 }  // namespace neraf::train

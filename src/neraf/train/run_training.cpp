@@ -53,15 +53,97 @@ std::optional<std::string> newest_intact_checkpoint(const std::string& run_dir) 
 
 // The calibration stage (infer/calibration.h) of a finished audio/joint run, unless done.
 void calibrate_if_needed(const TrainConfig& cfg, const std::string& run_dir,
-                         const std::string& checkpoint, int64_t step, const data::RirSet* rirs) {
-  if (cfg.modality == Modality::vision || !cfg.audio.energy_calibration || !rirs) return;
+                         const std::string& checkpoint, int64_t step,
+                         const std::vector<const data::RirSet*>& rirs) {
+  if (cfg.modality == Modality::vision || !cfg.audio.energy_calibration || rirs.empty()) return;
   if (infer::load_calibration(checkpoint, step)) return;
   const auto t0 = std::chrono::steady_clock::now();
-  const std::string path = infer::calibrate_run(run_dir, *rirs, checkpoint);
+  const std::string path = infer::calibrate_run(run_dir, rirs, checkpoint);
   info("calibrated the acoustic field on its training RIRs in " +
        std::to_string(static_cast<int>(std::lround(
            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()))) +
        " s → " + path);
+}
+
+// One scene's data: its posed images (for the data manifest and the vision-run check), the
+// manifest, and its RIRs (audio/joint).
+struct SceneData {
+  std::string data_dir;
+  data::ImageSet images;
+  nlohmann::json manifest;
+  std::unique_ptr<data::RirSet> rirs;
+};
+
+data::RirSet load_rirs(const TrainConfig& cfg, const TrainRunOptions& options,
+                       const std::string& data_dir, int64_t max_len) {
+  data::RirLoadOptions rload;
+  rload.progress = options.progress;
+  rload.stop = options.stop;              // Ctrl-C stops a feature-cache build too
+  rload.cache_dir = cfg.audio.cache_dir;  // --cache-dir, --cache-precision (recorded in config)
+  rload.half_precision = data::parse_cache_precision(cfg.audio.cache_precision);
+  rload.max_len = max_len;  // --max-len, else automatic (published or longest train)
+  return data::load_rir_set(data_dir, rload);
+}
+
+// The scenes of a multi-scene run (cfg.audio.vision_runs[s] is scene s's vision run), each checked
+// against its vision run, all of one layout, sample rate and STFT, and all with the same frames
+// per RIR: without --max-len the longest scene's automatic value, recorded in cfg.audio.max_len so
+// resume and eval load the same features. `old` is the run's data.json on resume.
+std::vector<SceneData> load_scenes(TrainConfig& cfg, const TrainRunOptions& options,
+                                   const std::vector<std::string>& data_dirs,
+                                   const nlohmann::json& old, bool resuming) {
+  std::vector<SceneData> scenes;
+  const std::vector<std::string> names = infer::name_scenes(data_dirs);
+  int64_t longest = 0;
+  for (size_t s = 0; s < data_dirs.size(); ++s) {
+    SceneData sc;
+    sc.data_dir = data_dirs[s];
+    data::ImageLoadOptions image_load;
+    image_load.progress = options.progress;
+    sc.images = data::load_transforms_json(sc.data_dir, image_load);
+    sc.manifest = infer::make_data_manifest(sc.images, sc.data_dir);
+    // Each scene's grid must come from its own room's field (the one-scene run's check).
+    infer::check_vision_run_data(cfg.audio.vision_runs[s], sc.manifest);
+    sc.rirs =
+        std::make_unique<data::RirSet>(load_rirs(cfg, options, sc.data_dir, cfg.audio.max_len));
+    if (s > 0) {
+      const nlohmann::json a = infer::make_audio_manifest(*scenes.front().rirs),
+                           b = infer::make_audio_manifest(*sc.rirs);
+      for (const char* key :
+           {"layout", "sample_rate", "channels", "n_fft", "win_length", "hop_length", "n_freq"})
+        require(a[key] == b[key], "--data " + sc.data_dir + ": its " + key + " (" + b[key].dump() +
+                                      ") differs from --data " + scenes.front().data_dir + "'s (" +
+                                      a[key].dump() +
+                                      "); one multi-scene run needs scenes of one layout, sample "
+                                      "rate and STFT: synthesise or convert them alike");
+    }
+    longest = std::max(longest, sc.rirs->max_len);
+    scenes.push_back(std::move(sc));
+  }
+  if (cfg.audio.max_len == 0)
+    for (SceneData& sc : scenes)
+      if (sc.rirs->max_len != longest) {
+        // Padded with the floor value past each RIR's end, as a shorter RIR is in any one scene.
+        sc.rirs = std::make_unique<data::RirSet>(load_rirs(cfg, options, sc.data_dir, longest));
+        cfg.audio.max_len = longest;
+      }
+  for (size_t s = 0; s < scenes.size(); ++s) {
+    SceneData& sc = scenes[s];
+    if (resuming && infer::is_multiscene(old)) {
+      require(old["scenes"].size() == scenes.size(),
+              "--data: this run was trained on " + std::to_string(old["scenes"].size()) +
+                  " scenes; resume with its own --data folders");
+      const nlohmann::json& was = old["scenes"][s];
+      for (const char* key : {"num_train", "height", "width", "train_files"})
+        require(was.value(key, nlohmann::json()) == sc.manifest[key],
+                sc.data_dir + ": differs from the dataset this run was trained on (" + key +
+                    "); resume with the original --data");
+      if (was.contains("audio")) infer::check_audio_manifest(was["audio"], *sc.rirs, sc.data_dir);
+    }
+    sc.manifest["audio"] = infer::make_audio_manifest(*sc.rirs);
+    sc.manifest["name"] = names[s];
+  }
+  return scenes;
 }
 
 }  // namespace
@@ -116,36 +198,63 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
   if (cfg.threads > 0) torch::set_num_threads(cfg.threads);
   torch::manual_seed(cfg.seed);  // anything that still draws from the global generator
 
+  const bool multi = infer::num_scenes(cfg) > 1;
   std::string data_dir = options.data_dir;
-  if (data_dir.empty() && old_manifest.contains("data")) data_dir = old_manifest["data"];
-  require(!data_dir.empty(), "--data: required (the dataset folder or its transforms.json)");
-  data::ImageLoadOptions image_load;
-  image_load.progress = options.progress;
-  const data::ImageSet images = data::load_transforms_json(data_dir, image_load);
-  nlohmann::json manifest = infer::make_data_manifest(images, data_dir);
-  if (cfg.modality == Modality::audio)
-    infer::check_vision_run_data(cfg.audio.vision_run, manifest);  // not another room's field
-  if (!old_manifest.is_null() && resume_from) {
-    for (const char* key : {"num_train", "height", "width", "train_files"})
-      require(old_manifest.value(key, nlohmann::json()) == manifest[key],
-              data_dir + ": differs from the dataset this run was trained on (" + key +
-                  "); resume with the original --data");
-  }
-  // The acoustic branch's RIRs (features cached next to the dataset) and their manifest.
+  std::vector<SceneData> scenes;
+  nlohmann::json manifest;
   std::unique_ptr<data::RirSet> rirs;
-  if (cfg.modality != Modality::vision) {
-    data::RirLoadOptions rload;
-    rload.progress = options.progress;
-    rload.stop = options.stop;              // Ctrl-C stops a feature-cache build too
-    rload.cache_dir = cfg.audio.cache_dir;  // --cache-dir, --cache-precision (recorded in config)
-    rload.half_precision = data::parse_cache_precision(cfg.audio.cache_precision);
-    rload.max_len = cfg.audio.max_len;  // --max-len, else automatic (published or longest train)
-    rirs = std::make_unique<data::RirSet>(data::load_rir_set(data_dir, rload));
-    if (!old_manifest.is_null() && resume_from && old_manifest.contains("audio"))
-      infer::check_audio_manifest(old_manifest["audio"], *rirs, data_dir);
-    manifest["audio"] = infer::make_audio_manifest(*rirs);
+  std::unique_ptr<Trainer> trainer;
+  std::vector<const data::RirSet*> all_rirs;  // what the calibration stage fits on
+  if (multi) {
+    std::vector<std::string> dirs = options.scene_data_dirs;
+    require(options.data_dir.empty(),
+            "--data: this multi-scene run needs one --data per --vision-run (" +
+                std::to_string(cfg.audio.vision_runs.size()) +
+                "), in the same order; on --resume give them all or none");
+    if (dirs.empty() && infer::is_multiscene(old_manifest))
+      for (const auto& sc : old_manifest["scenes"]) dirs.push_back(sc.value("data", std::string()));
+    require(dirs.size() == cfg.audio.vision_runs.size(),
+            "--data: a multi-scene run needs one --data per --vision-run, in the same order (" +
+                std::to_string(dirs.size()) + " --data, " +
+                std::to_string(cfg.audio.vision_runs.size()) + " --vision-run)");
+    scenes = load_scenes(cfg, options, dirs, old_manifest, resume_from.has_value());
+    manifest = {{"format", "neraf-run-data-1"}, {"scenes", nlohmann::json::array()}};
+    for (const SceneData& sc : scenes) {
+      manifest["scenes"].push_back(sc.manifest);
+      all_rirs.push_back(sc.rirs.get());
+    }
+    trainer = make_multiscene_trainer(cfg, all_rirs, options.device);
+  } else {
+    require(options.scene_data_dirs.empty(),
+            "--data: given " + std::to_string(options.scene_data_dirs.size()) +
+                " times but one --vision-run; a multi-scene run needs one --vision-run per --data "
+                "(with --modality audio)");
+    if (data_dir.empty() && old_manifest.contains("data")) data_dir = old_manifest["data"];
+    require(!data_dir.empty(), "--data: required (the dataset folder or its transforms.json)");
+    data::ImageLoadOptions image_load;
+    image_load.progress = options.progress;
+    scenes.emplace_back();
+    scenes.front().images = data::load_transforms_json(data_dir, image_load);
+    const data::ImageSet& images = scenes.front().images;
+    manifest = infer::make_data_manifest(images, data_dir);
+    if (cfg.modality == Modality::audio)
+      infer::check_vision_run_data(cfg.audio.vision_run, manifest);  // not another room's field
+    if (!old_manifest.is_null() && resume_from) {
+      for (const char* key : {"num_train", "height", "width", "train_files"})
+        require(old_manifest.value(key, nlohmann::json()) == manifest[key],
+                data_dir + ": differs from the dataset this run was trained on (" + key +
+                    "); resume with the original --data");
+    }
+    // The acoustic branch's RIRs (features cached next to the dataset) and their manifest.
+    if (cfg.modality != Modality::vision) {
+      rirs = std::make_unique<data::RirSet>(load_rirs(cfg, options, data_dir, cfg.audio.max_len));
+      if (!old_manifest.is_null() && resume_from && old_manifest.contains("audio"))
+        infer::check_audio_manifest(old_manifest["audio"], *rirs, data_dir);
+      manifest["audio"] = infer::make_audio_manifest(*rirs);
+      all_rirs.push_back(rirs.get());
+    }
+    trainer = make_trainer(cfg, &images, options.device, rirs.get());
   }
-  std::unique_ptr<Trainer> trainer = make_trainer(cfg, &images, options.device, rirs.get());
   if (resume_from) {
     trainer->load_checkpoint(*resume_from);
     info("resuming " + options.run_dir + " from step " +
@@ -164,14 +273,22 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
          "; pass --steps N to train further");
     if (resume_from) {
       summary.checkpoint = *resume_from;
-      calibrate_if_needed(cfg, options.run_dir, *resume_from, summary.start_step, rirs.get());
+      calibrate_if_needed(cfg, options.run_dir, *resume_from, summary.start_step, all_rirs);
     }
     return summary;
   }
 
-  info("training " + infer::to_string(cfg.modality) + " (preset " + cfg.preset + ", " +
-       std::to_string(images.train.size()) + " train / " + std::to_string(images.eval.size()) +
-       " eval images, " + std::to_string(torch::get_num_threads()) + " threads, " +
+  const std::string what =
+      multi ? std::to_string(scenes.size()) + " scenes, " + std::to_string([&] {
+                int64_t n = 0;
+                for (const auto* r : all_rirs) n += static_cast<int64_t>(r->train.size());
+                return n;
+              }()) +
+                  " train RIRs"
+            : std::to_string(scenes.front().images.train.size()) + " train / " +
+                  std::to_string(scenes.front().images.eval.size()) + " eval images";
+  info("training " + infer::to_string(cfg.modality) + " (preset " + cfg.preset + ", " + what +
+       ", " + std::to_string(torch::get_num_threads()) + " threads, " +
        nerf::to_string(cfg.model.precision) + " MLPs) → " + options.run_dir);
   Progress progress("train", cfg.steps - summary.start_step,
                     ProgressOptions{"step", 0.2, 10.0, options.progress});
@@ -245,7 +362,7 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
   }
   progress.finish();
   if (summary.interrupted) return summary;  // the caller says so (cli: exit 130)
-  calibrate_if_needed(cfg, options.run_dir, summary.checkpoint, summary.end_step, rirs.get());
+  calibrate_if_needed(cfg, options.run_dir, summary.checkpoint, summary.end_step, all_rirs);
   return summary;
 }
 

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "neraf/infer/train_config.h"
 
@@ -14,6 +15,10 @@ namespace neraf::train {
 
 struct TrainRunOptions {
   std::string data_dir;  // dataset folder or transforms.json
+  // A multi-scene run (config.audio.vision_runs, N ≥ 2): every scene's dataset in the order of
+  // its vision runs (data_dir is then unused); empty for one scene, and on resume (RUN/data.json
+  // records them).
+  std::vector<std::string> scene_data_dirs;
   std::string run_dir;
   bool resume = false;           // continue from the latest checkpoint in run_dir
   bool force = false;            // start over in a non-empty run_dir (its checkpoints are deleted)
@@ -43,7 +48,9 @@ struct TrainRunSummary {
 // (infer/calibration.h) unless interrupted. On resume the run's own config.json is used instead
 // (options.steps/threads may override those two) and a damaged latest checkpoint is skipped
 // for the one before. A diverged loss (NaN/Inf) stops with neraf::Error naming the term; the
-// last checkpoint stays.
+// last checkpoint stays. A multi-scene run loads every scene (one layout, sample rate and STFT;
+// each checked against its vision run; frames per RIR made equal) and writes RUN/data.json as
+// {"format", "scenes": [...]} (infer/run.h).
 TrainRunSummary run_training(const infer::TrainConfig& config, const TrainRunOptions& options);
 
 }  // namespace neraf::train

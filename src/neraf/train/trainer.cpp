@@ -268,4 +268,22 @@ std::unique_ptr<Trainer> make_trainer(const TrainConfig& config, const data::Ima
   return trainer;
 }
 
+std::unique_ptr<Trainer> make_multiscene_trainer(const TrainConfig& config,
+                                                 const std::vector<const data::RirSet*>& scenes,
+                                                 torch::Device device) {
+  validate(config, "config");
+  require(config.modality == Modality::audio && config.audio.vision_runs.size() == scenes.size(),
+          "multi-scene: one --vision-run per --data (--modality audio)");
+  auto trainer = std::make_unique<Trainer>(config, device);
+  std::vector<nerf::NerfactoModel> fields;
+  for (const std::string& dir : config.audio.vision_runs) {
+    LoadedRun vision = infer::load_run(dir, device);
+    for (auto& p : vision.model->parameters()) p.set_requires_grad(false);
+    fields.push_back(vision.model);
+  }
+  trainer->add_branch(
+      std::make_unique<AudioBranch>(config, scenes, fields, /*frozen_field=*/true, device));
+  return trainer;
+}
+
 }  // namespace neraf::train
