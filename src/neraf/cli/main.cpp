@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
   neraf::cli::register_metrics(app);
   neraf::cli::register_auralize(app);
   neraf::cli::register_train(app);
+  neraf::cli::register_launch(app);
   neraf::cli::register_render(app);
   neraf::cli::register_eval(app);
   neraf::cli::register_export(app);
@@ -77,6 +78,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "error: %s\n\n%s", e.what(), selected_command(app)->help().c_str());
     return 2;
+  } catch (const neraf::cli::ExitCode& e) {
+    return e.code;
   } catch (const neraf::Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;

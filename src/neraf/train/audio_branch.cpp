@@ -10,6 +10,7 @@
 #include "neraf/infer/audio_run.h"
 #include "neraf/infer/checkpoint.h"
 #include "neraf/metrics/room_acoustics.h"
+#include "neraf/train/distributed.h"
 #include "neraf/util/error.h"
 
 namespace neraf::train {
@@ -124,7 +125,15 @@ LossDict AudioBranch::losses(StepContext& ctx) {
   const int64_t D = decay_weight > 0 ? std::min<int64_t>(config_.audio.decay_rirs,
                                                          static_cast<int64_t>(train_rirs_.size()))
                                      : 0;
-  const auto [rir, frame] = sample_slices(ctx.gen, D);
+  auto [rir, frame] = sample_slices(ctx.gen, D);
+  // Data-parallel: this rank's rows of the global batch of B slices; the D whole RIRs of the
+  // energy-decay loss are the same on every rank (their mean gradient is theirs).
+  const int64_t Bl = ctx.shard.count(B);
+  if (!ctx.shard.whole()) {
+    const int64_t b0 = ctx.shard.begin(B);
+    rir = torch::cat({rir.narrow(0, b0, Bl), rir.slice(0, B)});
+    frame = torch::cat({frame.narrow(0, b0, Bl), frame.slice(0, B)});
+  }
   if (!batch_.defined() || batch_.size(0) != rir.size(0))
     batch_ = torch::empty({rir.size(0), rirs_.channels, rirs_.n_freq}, torch::kFloat32);
   rirs_.gather_into(rir, frame, batch_);
@@ -135,15 +144,18 @@ LossDict AudioBranch::losses(StepContext& ctx) {
   const torch::Tensor src = rirs_.source_positions.index_select(0, rir);
   const torch::Tensor rot = rirs_.rots.index_select(0, rir);
   const torch::Tensor pred = model_->forward(grid_->grid(), frame.to(device_), mic.to(device_),
-                                             src.to(device_), rot.to(device_));  // [B + D·T, C, F]
+                                             src.to(device_), rot.to(device_));  // [Bl + D·T, C, F]
   const acoustic::AudioLossTerms terms =
-      acoustic::sc_slmse_loss(pred.slice(0, 0, B), gt.slice(0, 0, B));
+      ctx.dist ? acoustic::sc_slmse_loss_sharded(
+                     pred.slice(0, 0, Bl), gt.slice(0, 0, Bl),
+                     [&](torch::Tensor& t) { ctx.dist->sum(t); }, ctx.shard.world_size)
+               : acoustic::sc_slmse_loss(pred.slice(0, 0, Bl), gt.slice(0, 0, Bl));
   ctx.metrics["audio_sl"] = terms.sl.item<double>();
   LossDict out{{"audio_sc_loss", terms.sc_loss}, {"audio_mag_loss", terms.mag_loss}};
   if (D > 0) {
     // [D·T, C, F] → [D, C, F, T]
     auto whole_rirs = [&](const torch::Tensor& x) {
-      return x.slice(0, B).view({D, T, x.size(1), x.size(2)}).permute({0, 2, 3, 1});
+      return x.slice(0, Bl).view({D, T, x.size(1), x.size(2)}).permute({0, 2, 3, 1});
     };
     const acoustic::AudioLossOptions lo;
     const torch::Tensor decay = acoustic::energy_decay_loss(whole_rirs(pred), whole_rirs(gt),
