@@ -2,6 +2,7 @@
 
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -98,6 +99,16 @@ struct Distributed::Impl {
       throw;
     }
   }
+
+  // Rank 0, before it throws a verdict the others must read: the store lives in rank 0, so it
+  // waits (a few seconds at most) until ranks 1..n-1 acknowledged `base` + rank.
+  void wait_acks(const std::string& base, int n, double seconds) {
+    for (int q = 1; q < n; ++q) try {
+        if (!wait_key(base + std::to_string(q), seconds)) return;
+      } catch (const std::exception&) {
+        return;  // that rank is gone already
+      }
+  }
 };
 
 Distributed::Distributed(const DistributedConfig& config)
@@ -152,12 +163,16 @@ Distributed::Distributed(const DistributedConfig& config)
                     "; start every rank with the same --world-size";
       }
       store.set("neraf/verdict", bytes_of(std::to_string(W) + "\n" + verdict));
-      if (!verdict.empty()) throw Error(verdict);
+      if (!verdict.empty()) {
+        impl_->wait_acks("neraf/verdict_ack/", W, std::min(config_.timeout_s, 10.0));
+        throw Error(verdict);
+      }
     } else {
       if (!impl_->wait_key("neraf/verdict", config_.setup_timeout_s + config_.timeout_s))
         throw Error("rank " + me + ": rank 0 at " + master + " did not confirm the ranks within " +
                     seconds_text(config_.setup_timeout_s + config_.timeout_s) + " s");
       const std::string v = text_of(store.get("neraf/verdict"));
+      store.set("neraf/verdict_ack/" + me, bytes_of("1"));
       const std::string ws = v.substr(0, v.find('\n'));
       const std::string message = v.substr(v.find('\n') + 1);
       if (!message.empty()) throw Error(message);
@@ -237,6 +252,7 @@ void Distributed::check_same_json(const std::string& key, const std::string& wha
                     "confirm the " + what + " within " + seconds_text(config_.setup_timeout_s) +
                     " s");
       const std::string verdict = text_of(store.get(base + "verdict"));
+      store.set(base + "ack" + std::to_string(r), bytes_of("1"));
       if (!verdict.empty()) throw Error(verdict);
       return;
     }
@@ -251,7 +267,10 @@ void Distributed::check_same_json(const std::string& key, const std::string& wha
       if (!m.empty() && verdict.empty()) verdict = m;
     }
     store.set(base + "verdict", bytes_of(verdict));
-    if (!verdict.empty()) throw Error(verdict);
+    if (!verdict.empty()) {
+      impl_->wait_acks(base + "ack", config_.world_size, std::min(config_.timeout_s, 10.0));
+      throw Error(verdict);
+    }
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
