@@ -58,7 +58,8 @@ t0=$(date +%s.%N)
 wait "$r0"
 rc=$?
 t1=$(date +%s.%N)
-wait "$r1" 2>/dev/null
+{ wait "$r1"; } 2>/dev/null
+echo "rank 0 stopped $(python3 -c "print(round($t1 - $t0, 2))") s after rank 1 was killed"
 [ "$rc" -eq 1 ] || fail "the surviving rank 0 exited $rc after rank 1 was killed: $(cat "$TMP/k0.err")"
 one_error_line "$TMP/k0.err" "distributed training, rank 0 of 2: .* failed"
 python3 -c "import sys; sys.exit(0 if $t1 - $t0 < 15 else 1)" ||
