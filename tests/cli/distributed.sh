@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Data-parallel training over c10d/Gloo on 127.0.0.1 (train/distributed.h), driven as a user
 # would: neraf launch with 2 processes, resume with another world size, a rank killed mid-run
-# (the survivor stops with a clear error within the timeout; the newest checkpoint loads), and
-# bad distributed input (one error line each, bounded in time, no run folder damaged).
+# (the survivor stops with a clear error within the timeout; the newest checkpoint loads),
+# Ctrl-C to launch, and bad distributed input (one error line each, bounded in time, no run
+# folder damaged).
 # (Parameter equality with one process: tests/train/distributed_test.cpp.)
 # Usage: distributed.sh <path to neraf> <assets dir>
 set -u
@@ -68,7 +69,23 @@ expect_exit 0 "$NERAF" train --out "$K" --resume --steps 6 --threads 1 --quiet
 grep -q "damaged" "$TMP/err" && fail "a damaged checkpoint after the kill: $(cat "$TMP/err")"
 expect_file "$K/checkpoints/step-000000006.pt"
 
-# 4. Bad distributed input: one error line each, within the timeout, no run folder left.
+# 4. Ctrl-C (SIGINT) to launch: forwarded once; every rank stops after the same step, rank 0
+# saves it, exit 0.
+I=$TMP/interrupted
+"$NERAF" launch -n 2 -- train --data "$S" --out "$I" --steps 100000 --save-every 100000 \
+  "${small[@]}" >"$TMP/i.out" 2>"$TMP/i.err" &
+li=$!
+for ((i = 0; i < 600; ++i)); do [ -f "$I/config.json" ] && break; sleep 0.1; done
+sleep 2
+kill -INT "$li"
+wait "$li"
+rc=$?
+[ "$rc" -eq 0 ] || fail "launch exited $rc after Ctrl-C: $(cat "$TMP/i.err")"
+expect_in "$TMP/i.err" "interrupted: checkpoint saved at step"
+[ "$(find "$I/checkpoints" -name 'step-*[0-9].pt' | wc -l)" -eq 1 ] ||
+  fail "expected the one checkpoint of the interrupt: $(ls "$I/checkpoints")"
+
+# 5. Bad distributed input: one error line each, within the timeout, no run folder left.
 B=$TMP/bad
 expect_exit 1 "$NERAF" train --data "$S" --out "$B" --world-size 2 --rank 2
 one_error_line "$TMP/err" "--rank 2: must be below --world-size 2"

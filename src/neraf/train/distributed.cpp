@@ -103,11 +103,13 @@ struct Distributed::Impl {
   // Rank 0, before it throws a verdict the others must read: the store lives in rank 0, so it
   // waits (a few seconds at most) until ranks 1..n-1 acknowledged `base` + rank.
   void wait_acks(const std::string& base, int n, double seconds) {
-    for (int q = 1; q < n; ++q) try {
+    for (int q = 1; q < n; ++q) {
+      try {
         if (!wait_key(base + std::to_string(q), seconds)) return;
       } catch (const std::exception&) {
         return;  // that rank is gone already
       }
+    }
   }
 };
 
