@@ -164,7 +164,7 @@ for e in $EXPERIMENTS; do
           train "e4_views${v}_vision_s$s" --data "$d" --modality vision --seed "$s" "${VIEWS_VISION[@]}"
           train "e4_views${v}_joint_s$s" --data "$d" --seed "$s" "${VIEWS_JOINT[@]}"
           evaluate "e4_views${v}_vision_s$s" "e4_views${v}_vision_s$s" --no-baselines
-          evaluate "e4_views${v}_joint_s$s" "e4_views${v}_joint_s$s" --no-baselines --no-images
+          evaluate "e4_views${v}_joint_s$s" "e4_views${v}_joint_s$s" --no-baselines
         done
       done
       ;;

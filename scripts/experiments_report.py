@@ -64,6 +64,7 @@ class Report:
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
+        plt.rcParams["figure.constrained_layout.use"] = True  # axis labels never overlap
         self.plt = plt
 
     def load(self, name):
@@ -213,7 +214,7 @@ class Report:
                "grid four times; BatchNorm would see one voxel), so 24 stands in for it.")
         self.w()
         for room, title in rooms:
-            evals = self.load("e2_" + room)
+            evals = relabel(self.load("e2_" + room))
             if not evals:
                 continue
             for part, what in (("audio", "held-out split"), ("novel", "new microphone positions")):
@@ -232,9 +233,9 @@ class Report:
                         xs = [(a["ablations"][name] if name in a.get("ablations", {}) else a.get(name, {}))
                               .get(metric) for a in part_of(evals, part)]
                         cells.append(pm([x for x in xs if x is not None], digits_for(metric)))
-                    self.w(f"| {short(name)} | " + " | ".join(cells) + " |")
+                    self.w(f"| {'full (S = 32)' if name == 'neraf' else name} | " + " | ".join(cells) + " |")
                 self.w()
-                self.paired_table(relabel(evals, part), part, "paired_ablations")
+                self.paired_table(evals, part, "paired_ablations")
             self.plot_ablation(evals, room, title)
 
     def plot_ablation(self, evals, room, title):
@@ -256,7 +257,7 @@ class Report:
                        yerr=[0 if math.isnan(e) else e for e in es], capsize=3,
                        label="held-out" if part == "audio" else "new positions")
             ax.set_xticks(range(len(names)))
-            ax.set_xticklabels([short(n).replace(" ", "\n") for n in names], fontsize=7)
+            ax.set_xticklabels([n.replace(" ", "\n") for n in names], fontsize=7)
             ax.set_ylabel(label)
             ax.grid(axis="y", alpha=0.3)
         axes[0].legend(fontsize=8)
@@ -359,7 +360,7 @@ class Report:
         self.image(fig, "e4_views.png", "sample held-out view")
 
     def experiment5(self):
-        evals = self.load("e5_raf_furnished")
+        evals = relabel(self.load("e5_raf_furnished"))
         if not evals:
             return
         self.w("## 5. The loss study")
@@ -376,9 +377,9 @@ class Report:
                 xs = [(a["ablations"][name] if name != "neraf" else a["neraf"]).get(metric)
                       for a in part_of(evals, "audio") if name == "neraf" or name in a.get("ablations", {})]
                 cells.append(pm([x for x in xs if x is not None], digits_for(metric)))
-            self.w(f"| {short(name)} | " + " | ".join(cells) + " |")
+            self.w(f"| {'SC+SL-MSE (full model)' if name == 'neraf' else name} | " + " | ".join(cells) + " |")
         self.w()
-        self.paired_table(relabel(evals, "audio"), "audio", "paired_ablations")
+        self.paired_table(evals, "audio", "paired_ablations")
 
     def write(self):
         a = self.args
@@ -413,7 +414,7 @@ def part_of(evals, part):
     return out
 
 
-def relabel(evals, part):
+def relabel(evals):
     """Ablation labels without the seed suffix, so seeds line up in paired tables."""
     out = {}
     for seed, e in evals.items():

@@ -103,6 +103,17 @@ bad --fps "$NERAF" render trajectory --run "$FIX" --path "$FIX/path.json" --in "
 
 # --- threads: at most 4 x the cores, and at least 1 -----------------------------------------
 bad --threads "$NERAF" train --data "$FIX" --out "$WORK/run" --threads 100000
+# Data-parallel training (train/distributed.h; the network cases: tests/cli/distributed.sh).
+bad --world-size "$NERAF" train --data "$FIX" --out "$WORK/run" --world-size 0
+bad --world-size "$NERAF" train --data "$FIX" --out "$WORK/run" --world-size 1e9
+bad --rank "$NERAF" train --data "$FIX" --out "$WORK/run" --world-size 2 --rank -1
+bad --rank "$NERAF" train --data "$FIX" --out "$WORK/run" --world-size 2 --rank 5
+bad --dist-timeout "$NERAF" train --data "$FIX" --out "$WORK/run" --world-size 2 --dist-timeout nan
+bad --master "$NERAF" train --data "$FIX" --out "$WORK/run" --world-size 2 --master host:99999
+bad --nproc "$NERAF" launch -n 0 -- train --data "$FIX" --out "$WORK/run"
+bad --nproc "$NERAF" launch -n 1000 -- train --data "$FIX" --out "$WORK/run"
+bad --master-port "$NERAF" launch -n 2 --master-port 70000 -- train --data "$FIX" --out "$WORK/run"
+bad --grace "$NERAF" launch -n 2 --grace -1 -- train --data "$FIX" --out "$WORK/run"
 bad --threads "$NERAF" eval --run "$FIX" --json "$WORK/e.json" --threads 0
 bad --threads "$NERAF" synth --preset demo --out "$WORK/ds" --threads -1
 bad --threads "$NERAF" render rir --run "$FIX" --mic 1,1,1 --src 2,1,1 --out "$WORK/r.wav" \

@@ -266,7 +266,7 @@ TEST(TrainConfig, ReferencePresetIsThePublishedModel) {
 
 TEST(TrainConfig, GridResolutionMustPassTheSceneEncoder) {
   TrainConfig c = train_preset("cpu");
-  c.modality = Modality::audio;
+  c.modality = Modality::joint;
   c.audio.grid_resolution = 16;  // halved four times: one voxel at the last BatchNorm
   EXPECT_THROW(validate(c, "config.json"), Error);
   c.audio.grid_resolution = 17;

@@ -11,6 +11,20 @@ std::optional<AudioCriterion> parse_audio_criterion(const std::string& name) {
   return std::nullopt;
 }
 
+namespace {
+// t.sc given: the criterion's log-magnitude term and the weighted sum (p, g: float32 log-mags).
+AudioLossTerms with_log_magnitude_term(AudioLossTerms t, const torch::Tensor& p,
+                                       const torch::Tensor& g, const AudioLossOptions& options) {
+  t.sl =
+      options.criterion == AudioCriterion::sc_sll1 ? torch::l1_loss(p, g) : torch::mse_loss(p, g);
+  const double sc_weight = options.criterion == AudioCriterion::mse ? 0.0 : options.sc_weight;
+  t.sc_loss = t.sc * (options.loss_factor * sc_weight);
+  t.mag_loss = t.sl * (options.loss_factor * options.mag_weight);
+  t.total = t.sc_loss + t.mag_loss;
+  return t;
+}
+}  // namespace
+
 AudioLossTerms spectral_loss(const torch::Tensor& pred, const torch::Tensor& gt,
                              const AudioLossOptions& options) {
   TORCH_CHECK(pred.sizes() == gt.sizes(), "spectral_loss: pred ", pred.sizes(), " vs gt ",
@@ -21,13 +35,29 @@ AudioLossTerms spectral_loss(const torch::Tensor& pred, const torch::Tensor& gt,
   const auto y = torch::exp(g) - 1e-3;
   AudioLossTerms t;
   t.sc = torch::norm(y - x) / torch::norm(y);  // Frobenius over the whole batch
-  t.sl =
-      options.criterion == AudioCriterion::sc_sll1 ? torch::l1_loss(p, g) : torch::mse_loss(p, g);
-  const double sc_weight = options.criterion == AudioCriterion::mse ? 0.0 : options.sc_weight;
-  t.sc_loss = t.sc * (options.loss_factor * sc_weight);
-  t.mag_loss = t.sl * (options.loss_factor * options.mag_weight);
-  t.total = t.sc_loss + t.mag_loss;
-  return t;
+  return with_log_magnitude_term(t, p, g, options);
+}
+
+AudioLossTerms spectral_loss_sharded(const torch::Tensor& pred, const torch::Tensor& gt,
+                                     const std::function<void(torch::Tensor&)>& sum_over_ranks,
+                                     int world_size, const AudioLossOptions& options) {
+  TORCH_CHECK(pred.sizes() == gt.sizes(), "spectral_loss_sharded: pred ", pred.sizes(), " vs gt ",
+              gt.sizes());
+  const auto p = pred.to(torch::kFloat32);
+  const auto g = gt.to(torch::kFloat32);
+  const auto x = torch::exp(p) - 1e-3;
+  const auto y = torch::exp(g) - 1e-3;
+  const torch::Tensor num = (y - x).pow(2).sum();  // [] this rank's ‖Y − X‖²
+  torch::Tensor sums = torch::stack({num.detach(), y.pow(2).sum().detach()});  // [2]
+  sum_over_ranks(sums);
+  const torch::Tensor n_all = sums[0].clamp_min(1e-30), d_all = sums[1].clamp_min(1e-30);
+  const torch::Tensor sc_all = torch::sqrt(n_all / d_all);  // [] the global SC
+  // d(√(N/D))/dnum = 1 / (2·√N·√D): this rank's share of the gradient, × world_size because the
+  // trainer averages the ranks' gradients.
+  const torch::Tensor surrogate = num * (world_size / (2.0 * torch::sqrt(n_all * d_all)));
+  AudioLossTerms t;
+  t.sc = surrogate + (sc_all - surrogate).detach();  // value: the global SC
+  return with_log_magnitude_term(t, p, g, options);
 }
 
 torch::Tensor energy_decay_loss(const torch::Tensor& pred, const torch::Tensor& gt, double eps,

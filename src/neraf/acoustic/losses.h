@@ -22,6 +22,7 @@
 // differences, while T60 (down to −35 dB), EDT and C50 only look at the top of the curve.
 #include <torch/types.h>
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -53,6 +54,18 @@ struct AudioLossTerms {
 // pred, gt: [B, C, F] (any equal shape) log-magnitudes.
 AudioLossTerms spectral_loss(const torch::Tensor& pred, const torch::Tensor& gt,
                              const AudioLossOptions& options = {});
+
+// The same objective when the batch is split over `world_size` data-parallel ranks of equal
+// shares (train/distributed.h), each calling this on its own rows: `sum_over_ranks` sums a small
+// tensor in place over the ranks. The spectral convergence is a ratio of norms over the whole
+// batch, not a mean, so its two sums of squares are summed over the ranks; the returned sc's
+// value is the global SC on every rank and its gradient is world_size × this rank's share of the
+// global SC's gradient, so the mean of the ranks' gradients is the gradient of the global SC
+// (the trainer averages gradients). sl is this rank's mean (equal shares: the mean of the ranks'
+// means is the global mean).
+AudioLossTerms spectral_loss_sharded(const torch::Tensor& pred, const torch::Tensor& gt,
+                                     const std::function<void(torch::Tensor&)>& sum_over_ranks,
+                                     int world_size, const AudioLossOptions& options = {});
 
 // pred, gt: [B, C, F, T] log-magnitudes of whole RIRs → [] raw energy-decay L1 (unweighted).
 torch::Tensor energy_decay_loss(const torch::Tensor& pred, const torch::Tensor& gt,

@@ -15,5 +15,12 @@ void register_info(CLI::App& app);
 void register_synth(CLI::App& app);
 void register_export(CLI::App& app);
 void register_calibrate(CLI::App& app);
+void register_launch(CLI::App& app);
+
+// Thrown by a command to exit with `code` without printing anything more (launch passes on a
+// failed child's exit code; the child printed its own error).
+struct ExitCode {
+  int code;
+};
 
 }  // namespace neraf::cli

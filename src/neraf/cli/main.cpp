@@ -108,6 +108,7 @@ int main(int argc, char** argv) {
   neraf::cli::register_metrics(app);
   neraf::cli::register_auralize(app);
   neraf::cli::register_train(app);
+  neraf::cli::register_launch(app);
   neraf::cli::register_render(app);
   neraf::cli::register_eval(app);
   neraf::cli::register_export(app);
@@ -135,6 +136,8 @@ int main(int argc, char** argv) {
   } catch (const neraf::Interrupted& e) {
     std::fprintf(stderr, "interrupted: %s\n", e.what());
     return 130;
+  } catch (const neraf::cli::ExitCode& e) {
+    return e.code;
   } catch (const neraf::Error& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -14,6 +15,7 @@
 #include "neraf/cli/flag_checks.h"
 #include "neraf/infer/train_config.h"
 #include "neraf/nerf/config.h"
+#include "neraf/train/distributed.h"
 #include "neraf/train/interrupt.h"
 #include "neraf/train/run_training.h"
 #include "neraf/util/error.h"
@@ -54,6 +56,11 @@ struct TrainArgs {
   CLI::Option* grid_resolution_opt = nullptr;
   int keep = 3;
   int64_t save_every = 0;
+  int world_size = 1;
+  int rank = 0;
+  std::string master = "127.0.0.1:29500";
+  double dist_timeout = 60;
+  std::string dist_interface;
 };
 
 // The flag's own bound; the memory check below is the one that usually applies.
@@ -109,6 +116,9 @@ void register_train(CLI::App& app) {
       "(frames per RIR: --max-len, else the longest scene's). Render, export and auralize take\n"
       "--scene NAME|INDEX (NAME: the dataset folder's name); eval scores every scene and their\n"
       "mean. Joint multi-scene training is not implemented.\n"
+      "Several processes: --world-size N --rank R --master HOST:PORT on each (rank 0 writes\n"
+      "the run folder), or neraf launch -n N -- train ... on one machine; README, \"Several\n"
+      "processes or machines\".\n"
       "Example: neraf train --data demo/ --out runs/demo\n"
       "         neraf train --modality audio --data a/ --vision-run runs/a-vision --data b/\n"
       "           --vision-run runs/b-vision --out runs/ab");
@@ -229,8 +239,50 @@ void register_train(CLI::App& app) {
                       "may change on --resume)")
           ->transform(whole_number(1, kMaxSteps));
 
+  CLI::Option* world_size =
+      cmd->add_option("--world-size", args->world_size,
+                      "Data-parallel training: the number of processes (ranks), on this machine "
+                      "(see neraf launch) or several; every rank trains its share of the same "
+                      "global batch")
+          ->transform(whole_number(1, 1024))
+          ->capture_default_str();
+  CLI::Option* rank =
+      cmd->add_option("--rank", args->rank,
+                      "With --world-size: this process's rank in [0, world size); rank 0 writes "
+                      "the run folder")
+          ->transform(whole_number(0, 1023));
+  CLI::Option* master = cmd->add_option("--master", args->master,
+                                        "With --world-size: HOST:PORT where rank 0 listens (a TCP "
+                                        "port of rank 0's machine that the others can reach)")
+                            ->capture_default_str();
+  CLI::Option* dist_timeout =
+      cmd->add_option("--dist-timeout", args->dist_timeout,
+                      "With --world-size: seconds any rank waits for the others (joining, each "
+                      "all-reduce) before stopping with an error")
+          ->check(real_number(0.1, 86400))
+          ->capture_default_str();
+  CLI::Option* dist_interface =
+      cmd->add_option("--dist-interface", args->dist_interface,
+                      "With --world-size: the network interface for the ranks' traffic (e.g. "
+                      "eth0; default: the address this host's name resolves to)");
+
   cmd->callback([args, data, preset, steps, seed, threads, rays, precision, grid, fraction,
-                 vision_run, audio_start, decay_loss, no_relative, save_every]() {
+                 vision_run, audio_start, decay_loss, no_relative, save_every, world_size, rank,
+                 master, dist_timeout, dist_interface]() {
+    if (args->world_size == 1)
+      for (CLI::Option* o : {rank, master, dist_timeout, dist_interface})
+        require(o->count() == 0, o->get_name() + ": only with --world-size N (N > 1)");
+    require(args->rank < args->world_size, "--rank " + std::to_string(args->rank) +
+                                               ": must be below --world-size " +
+                                               std::to_string(args->world_size) + " (ranks 0.." +
+                                               std::to_string(args->world_size - 1) + ")");
+    train::DistributedConfig dist;
+    dist.world_size = args->world_size;
+    dist.rank = args->rank;
+    dist.timeout_s = args->dist_timeout;
+    dist.setup_timeout_s = std::max(dist.setup_timeout_s, args->dist_timeout);
+    dist.interface = args->dist_interface;
+    if (args->world_size > 1) train::parse_master(args->master, "--master", dist);
     require(!(args->resume && args->force), "--resume and --force: choose one");
     require(args->resume || data->count() > 0, "--data: required (the dataset folder)");
     // The flags as given (unset: the preset's value for the modality), resolved in one place.
@@ -297,9 +349,11 @@ void register_train(CLI::App& app) {
       if (steps->count()) opts.steps = args->steps;
       if (threads->count()) opts.threads = args->threads;
     }
+    opts.distributed = dist;
     train::InterruptGuard interrupt;
     opts.stop = &interrupt.flag();
     const train::TrainRunSummary s = train::run_training(cfg, opts);
+    if (dist.rank > 0) return;  // rank 0 reports
     if (s.end_step > s.start_step) {
       std::printf("trained steps %lld..%lld in %.1f s (%.2f steps/s)",
                   static_cast<long long>(s.start_step), static_cast<long long>(s.end_step),
@@ -308,6 +362,10 @@ void register_train(CLI::App& app) {
         std::printf("; %.0f rays/s, train PSNR %.2f dB", s.rays_per_s, s.last_psnr);
       if (cfg.modality != infer::Modality::vision)
         std::printf("; audio log-mag MSE %.4f", s.last_audio_sl);
+      if (s.comm.allreduces > 0)
+        std::printf("; all-reduce %.1f MB/step, %.1f ms/step",
+                    double(s.comm.bytes) / double(s.comm.allreduces) / 1e6,
+                    1e3 * s.comm.seconds / double(s.comm.allreduces));
       std::printf("; checkpoint %s\n", s.checkpoint.c_str());
     }
     if (s.interrupted)

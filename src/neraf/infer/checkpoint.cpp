@@ -71,7 +71,11 @@ std::string checkpoint_damage(const std::string& path) {
 void load_archive(torch::serialize::InputArchive& archive, const std::string& path) {
   std::error_code ec;
   require(fs::is_regular_file(path, ec), path + ": no such checkpoint file; check the run folder");
-  const std::string file = io::read_text_file(path);
+  load_archive_bytes(archive, io::read_text_file(path), path);
+}
+
+void load_archive_bytes(torch::serialize::InputArchive& archive, const std::string& file,
+                        const std::string& path) {
   const std::string fix = "; delete it to resume from the previous checkpoint";
   try {
     if (io::has_magic(file,

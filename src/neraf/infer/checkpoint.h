@@ -40,6 +40,10 @@ void save_archive(torch::serialize::OutputArchive& archive, const std::string& p
 // Reads an archive; a missing, truncated, foreign or damaged (checksum) file is a neraf::Error
 // naming it. Unsealed archives (written before checksums) still load.
 void load_archive(torch::serialize::InputArchive& archive, const std::string& path);
+// The same from a checkpoint file's bytes (`path` names it in errors): what rank 0 of a
+// distributed run read and broadcast.
+void load_archive_bytes(torch::serialize::InputArchive& archive, const std::string& file,
+                        const std::string& path);
 // "" when the file's seal is intact, else why not (truncated, damaged, ...), without parsing
 // the archive (resume falls back past damaged checkpoints with this).
 std::string checkpoint_damage(const std::string& path);

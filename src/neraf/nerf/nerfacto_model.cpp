@@ -12,13 +12,13 @@ NerfactoModelImpl::NerfactoModelImpl(const ModelConfig& config, int64_t num_trai
                                      uint64_t seed)
     : config_(config), num_train_images_(num_train_images) {
   validate(config, "model");
-  field = register_module("field", NerfactoField(config.field, num_train_images, config.precision,
-                                                 seed * 7919 + 100));
+  field = register_module(
+      "field", NerfactoField(config.field, num_train_images, config.precision, seed * 7919 + 100));
   for (size_t i = 0; i < config.proposal_nets.size(); ++i)
-    proposal_nets.push_back(register_module(
-        "proposal_" + std::to_string(i),
-        ProposalField(config.proposal_nets[i], config.field.average_init_density,
-                      config.precision, seed * 7919 + 200 + 10 * i)));
+    proposal_nets.push_back(
+        register_module("proposal_" + std::to_string(i),
+                        ProposalField(config.proposal_nets[i], config.field.average_init_density,
+                                      config.precision, seed * 7919 + 200 + 10 * i)));
   camera_optimizer =
       register_module("camera_optimizer", CameraOptimizer(config.camera_opt, num_train_images));
 }
@@ -56,11 +56,11 @@ ModelOutputs NerfactoModelImpl::forward(RayBundle rays, const ForwardOptions& op
     const int64_t n = sc.proposal_samples[level];
     if (level == 0)
       samples = uniform_lindisp_samples(rays.nears, rays.fars, n, training, sc.single_jitter,
-                                        options.gen);
+                                        options.gen, options.rows);
     else
-      samples = pdf_samples(samples, torch::pow(weights, options.anneal), rays.nears, rays.fars,
-                            n, training, sc.single_jitter, sc.histogram_padding, sc.pdf_eps,
-                            options.gen);
+      samples = pdf_samples(samples, torch::pow(weights, options.anneal), rays.nears, rays.fars, n,
+                            training, sc.single_jitter, sc.histogram_padding, sc.pdf_eps,
+                            options.gen, options.rows);
     torch::Tensor density;
     if (options.proposal_grad && training) {
       density = proposal_nets[level]->forward(sample_positions(rays, samples));
@@ -75,11 +75,11 @@ ModelOutputs NerfactoModelImpl::forward(RayBundle rays, const ForwardOptions& op
   }
   samples = pdf_samples(samples, torch::pow(weights, options.anneal), rays.nears, rays.fars,
                         sc.nerf_samples, training, sc.single_jitter, sc.histogram_padding,
-                        sc.pdf_eps, options.gen);
+                        sc.pdf_eps, options.gen, options.rows);
 
   // ---- radiance field ---------------------------------------------------------------------
-  const auto f = field->forward(sample_positions(rays, samples), rays.directions,
-                                rays.camera_indices);
+  const auto f =
+      field->forward(sample_positions(rays, samples), rays.directions, rays.camera_indices);
   weights = compute_weights(f.density, samples.deltas());
   out.weights.push_back(weights);
   out.sdist.push_back(samples.sdist);
@@ -103,8 +103,7 @@ LossDict NerfactoModelImpl::losses(const ModelOutputs& outputs, const torch::Ten
         config_.loss.interlevel_loss_mult * interlevel_loss(outputs.weights, outputs.sdist);
     d["distortion_loss"] = config_.loss.distortion_loss_mult *
                            distortion_loss(outputs.weights.back(), outputs.sdist.back());
-    if (camera_optimizer->enabled())
-      d["camera_opt_regularizer"] = camera_optimizer->regularizer();
+    if (camera_optimizer->enabled()) d["camera_opt_regularizer"] = camera_optimizer->regularizer();
   }
   return d;
 }

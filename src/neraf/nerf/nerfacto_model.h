@@ -15,6 +15,7 @@
 #include "neraf/nerf/config.h"
 #include "neraf/nerf/nerfacto_field.h"
 #include "neraf/nerf/rays.h"
+#include "neraf/nerf/samplers.h"
 
 namespace at {
 class Generator;
@@ -29,16 +30,17 @@ struct ForwardOptions {
   bool proposal_grad = true;     // run the proposal networks with autograd (update schedule)
   double anneal = 1.0;           // exponent applied to proposal weights before PDF sampling
   at::Generator* gen = nullptr;  // CPU generator for the sampling jitter (training only)
+  JitterRows rows;               // the rays' rows in a larger batch (data-parallel training)
 };
 
 struct ModelOutputs {
-  torch::Tensor rgb;                    // [R, 3] (clamped to [0, 1] in eval mode)
-  torch::Tensor accumulation;           // [R]
-  torch::Tensor depth;                  // [R] median depth, eval mode only (undefined in training)
-  torch::Tensor expected_depth;         // [R] eval mode only
-  std::vector<torch::Tensor> weights;   // per level (proposal levels, then nerf): [R, S_k]
-  std::vector<torch::Tensor> sdist;     // per level: [R, S_k + 1] spacing-space edges
-  std::vector<torch::Tensor> tdist;     // per level: [R, S_k + 1] euclidean edges
+  torch::Tensor rgb;                   // [R, 3] (clamped to [0, 1] in eval mode)
+  torch::Tensor accumulation;          // [R]
+  torch::Tensor depth;                 // [R] median depth, eval mode only (undefined in training)
+  torch::Tensor expected_depth;        // [R] eval mode only
+  std::vector<torch::Tensor> weights;  // per level (proposal levels, then nerf): [R, S_k]
+  std::vector<torch::Tensor> sdist;    // per level: [R, S_k + 1] spacing-space edges
+  std::vector<torch::Tensor> tdist;    // per level: [R, S_k + 1] euclidean edges
 };
 
 class NerfactoModelImpl : public torch::nn::Module {

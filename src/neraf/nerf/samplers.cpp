@@ -29,22 +29,28 @@ torch::Tensor spacing_to_euclidean(const torch::Tensor& s, const torch::Tensor& 
 }
 
 namespace {
-// Uniform [0,1) randoms of `shape` from the CPU generator, moved to `device`.
-torch::Tensor uniform(at::IntArrayRef shape, at::Generator* gen, const torch::Device& device) {
-  torch::Tensor r = gen ? torch::rand(shape, *gen, torch::kFloat32) : torch::rand(shape);
+// Uniform [0,1) randoms [R, K] from the CPU generator, moved to `device`; with rows.total, drawn
+// for all rows.total rows and rows [begin, begin + R) kept.
+torch::Tensor uniform(int64_t R, int64_t K, at::Generator* gen, const torch::Device& device,
+                      JitterRows rows) {
+  const int64_t n = rows.total > 0 ? rows.total : R;
+  TORCH_CHECK(rows.begin >= 0 && rows.begin + R <= n, "JitterRows: rows ", rows.begin, "+", R,
+              " outside ", n);
+  torch::Tensor r = gen ? torch::rand({n, K}, *gen, torch::kFloat32) : torch::rand({n, K});
+  if (n != R) r = r.narrow(0, rows.begin, R);
   return r.to(device);
 }
 }  // namespace
 
 RaySamples uniform_lindisp_samples(const torch::Tensor& nears, const torch::Tensor& fars,
                                    int64_t num_samples, bool jitter, bool single_jitter,
-                                   at::Generator* gen) {
+                                   at::Generator* gen, JitterRows rows) {
   const int64_t R = nears.size(0);
   const auto opts = nears.options().dtype(torch::kFloat32);
   torch::Tensor bins = torch::linspace(0.0, 1.0, num_samples + 1, opts).unsqueeze(0);  // [1, S+1]
   if (jitter) {
     const torch::Tensor t_rand =
-        uniform({R, single_jitter ? 1 : num_samples + 1}, gen, nears.device());
+        uniform(R, single_jitter ? 1 : num_samples + 1, gen, nears.device(), rows);
     const torch::Tensor centers = (bins.slice(1, 1) + bins.slice(1, 0, -1)) * 0.5;  // [1, S]
     const torch::Tensor upper = torch::cat({centers, bins.slice(1, -1)}, 1);
     const torch::Tensor lower = torch::cat({bins.slice(1, 0, 1), centers}, 1);
@@ -58,7 +64,7 @@ RaySamples uniform_lindisp_samples(const torch::Tensor& nears, const torch::Tens
 RaySamples pdf_samples(const RaySamples& prev, const torch::Tensor& weights,
                        const torch::Tensor& nears, const torch::Tensor& fars, int64_t num_samples,
                        bool stratified, bool single_jitter, double histogram_padding, double eps,
-                       at::Generator* gen) {
+                       at::Generator* gen, JitterRows rows) {
   torch::NoGradGuard no_grad;  // sample positions carry no gradient (nerfstudio detaches them)
   const int64_t R = weights.size(0);
   const int64_t num_bins = num_samples + 1;
@@ -75,7 +81,7 @@ RaySamples pdf_samples(const RaySamples& prev, const torch::Tensor& weights,
   torch::Tensor u = torch::linspace(0.0, 1.0 - 1.0 / num_bins, num_bins, opts).unsqueeze(0);
   if (stratified) {
     const torch::Tensor r =
-        uniform({R, single_jitter ? 1 : num_bins}, gen, weights.device()) / num_bins;
+        uniform(R, single_jitter ? 1 : num_bins, gen, weights.device(), rows) / num_bins;
     u = u + r;
   } else {
     u = (u + 1.0 / (2 * num_bins)).expand({R, num_bins});

@@ -34,13 +34,22 @@ torch::Tensor lindisp_piecewise_spacing_inv(const torch::Tensor& s);
 torch::Tensor spacing_to_euclidean(const torch::Tensor& s, const torch::Tensor& nears,
                                    const torch::Tensor& fars);
 
+// Which rows of a larger batch the R rays are (data-parallel training, train/distributed.h):
+// the randoms are drawn for all `total` rows and rows [begin, begin + R) are used, so a rank's
+// slice of a global batch gets exactly the jitter one process would give those rays.
+// total = 0: the R rays are the whole batch.
+struct JitterRows {
+  int64_t total = 0;
+  int64_t begin = 0;
+};
+
 // Initial sampler: edges linspace(0, 1, S + 1). With `jitter`, each edge moves uniformly within
 // its half-cells (between neighbouring bin centres; the first/last stay in [0, ½ bin] /
 // [1 − ½ bin, 1]) by one random offset per ray (single_jitter) or per edge; randoms come from
 // `gen` (CPU generator) and are moved to the device of `nears`.
 RaySamples uniform_lindisp_samples(const torch::Tensor& nears, const torch::Tensor& fars,
                                    int64_t num_samples, bool jitter, bool single_jitter,
-                                   at::Generator* gen);
+                                   at::Generator* gen, JitterRows rows = {});
 
 // PDF resampling in spacing space (nerfstudio PDFSampler, include_original=False):
 // weights + histogram_padding, then padding so that Σ ≥ eps, cdf = min(1, cumsum); u on
@@ -51,7 +60,7 @@ RaySamples uniform_lindisp_samples(const torch::Tensor& nears, const torch::Tens
 RaySamples pdf_samples(const RaySamples& prev, const torch::Tensor& weights,
                        const torch::Tensor& nears, const torch::Tensor& fars, int64_t num_samples,
                        bool stratified, bool single_jitter, double histogram_padding, double eps,
-                       at::Generator* gen);
+                       at::Generator* gen, JitterRows rows = {});
 
 // Proposal weight annealing exponent: b·x/((b − 1)·x + 1), x = clip(step/max_iters, 0, 1).
 double proposal_weight_anneal(int64_t step, double slope, int64_t max_iters);

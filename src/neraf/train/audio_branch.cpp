@@ -11,6 +11,7 @@
 #include "neraf/infer/audio_run.h"
 #include "neraf/infer/checkpoint.h"
 #include "neraf/metrics/room_acoustics.h"
+#include "neraf/train/distributed.h"
 #include "neraf/util/error.h"
 
 namespace neraf::train {
@@ -192,8 +193,16 @@ LossDict AudioBranch::losses(StepContext& ctx) {
   const int64_t B = config_.audio.batch_size, T = scenes_.front().rirs->max_len;
   const double decay_weight = config_.audio.decay_weight;
   const int64_t D = decay_weight > 0 ? std::min<int64_t>(config_.audio.decay_rirs, n_train_) : 0;
-  const auto [pos, frame] = sample_slices(ctx.gen, D);
-  torch::Tensor pred, gt;  // [B + D·T, C, F]
+  auto [pos, frame] = sample_slices(ctx.gen, D);
+  // Data-parallel: this rank's rows of the global batch of B slices; the D whole RIRs of the
+  // energy-decay loss are the same on every rank (their mean gradient is theirs).
+  const int64_t Bl = ctx.shard.count(B);
+  if (!ctx.shard.whole()) {
+    const int64_t b0 = ctx.shard.begin(B);
+    pos = torch::cat({pos.narrow(0, b0, Bl), pos.slice(0, B)});
+    frame = torch::cat({frame.narrow(0, b0, Bl), frame.slice(0, B)});
+  }
+  torch::Tensor pred, gt;  // [Bl + D·T, C, F]
   if (scenes_.size() == 1) {
     const Scene& sc = scenes_.front();
     const data::RirSet& rirs = *sc.rirs;
@@ -201,27 +210,31 @@ LossDict AudioBranch::losses(StepContext& ctx) {
     if (!batch_.defined() || batch_.size(0) != rir.size(0))
       batch_ = torch::empty({rir.size(0), rirs.channels, rirs.n_freq}, torch::kFloat32);
     rirs.gather_into(rir, frame, batch_);
-    gt = batch_.to(device_);  // [B + D·T, C, F]
+    gt = batch_.to(device_);
     // Metres: the model normalises them by the audio box for the position encodings and takes
     // the relative geometry from the metres themselves (nacf_input).
     const torch::Tensor mic = rirs.mic_positions.index_select(0, rir);
     const torch::Tensor src = rirs.source_positions.index_select(0, rir);
     const torch::Tensor rot = rirs.rots.index_select(0, rir);
     pred = model_->forward(sc.grid->grid(), frame.to(device_), mic.to(device_), src.to(device_),
-                           rot.to(device_));  // [B + D·T, C, F]
+                           rot.to(device_));
   } else {
-    std::tie(pred, gt) = forward_scenes(pos, frame, B);
+    std::tie(pred, gt) = forward_scenes(pos, frame, Bl);
   }
   acoustic::AudioLossOptions loss_options;
   loss_options.criterion = *acoustic::parse_audio_criterion(config_.audio.loss);  // validated
   const acoustic::AudioLossTerms terms =
-      acoustic::spectral_loss(pred.slice(0, 0, B), gt.slice(0, 0, B), loss_options);
+      ctx.dist
+          ? acoustic::spectral_loss_sharded(
+                pred.slice(0, 0, Bl), gt.slice(0, 0, Bl),
+                [&](torch::Tensor& t) { ctx.dist->sum(t); }, ctx.shard.world_size, loss_options)
+          : acoustic::spectral_loss(pred.slice(0, 0, Bl), gt.slice(0, 0, Bl), loss_options);
   ctx.metrics["audio_sl"] = terms.sl.item<double>();
   LossDict out{{"audio_sc_loss", terms.sc_loss}, {"audio_mag_loss", terms.mag_loss}};
   if (D > 0) {
     // [D·T, C, F] → [D, C, F, T]
     auto whole_rirs = [&](const torch::Tensor& x) {
-      return x.slice(0, B).view({D, T, x.size(1), x.size(2)}).permute({0, 2, 3, 1});
+      return x.slice(0, Bl).view({D, T, x.size(1), x.size(2)}).permute({0, 2, 3, 1});
     };
     const acoustic::AudioLossOptions lo;
     const torch::Tensor decay = acoustic::energy_decay_loss(whole_rirs(pred), whole_rirs(gt),

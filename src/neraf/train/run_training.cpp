@@ -14,6 +14,7 @@
 #include "neraf/io/atomic_file.h"
 #include "neraf/io/folder_lock.h"
 #include "neraf/io/json_file.h"
+#include "neraf/train/distributed.h"
 #include "neraf/train/trainer.h"
 #include "neraf/util/error.h"
 #include "neraf/util/log.h"
@@ -150,50 +151,94 @@ std::vector<SceneData> load_scenes(TrainConfig& cfg, const TrainRunOptions& opti
 
 namespace {
 
-TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOptions& options) {
+// What every rank must share, without what may differ per machine (paths, threads).
+std::string comparable_flags(const TrainConfig& cfg, bool resume) {
+  if (resume) return nlohmann::json{{"resume", true}}.dump();  // rank 0's config.json is used
+  nlohmann::json j = infer::to_json(cfg);
+  j.erase("threads");
+  if (j.contains("audio") && j["audio"].is_object()) {
+    j["audio"].erase("cache_dir");
+    j["audio"].erase("vision_run");
+  }
+  return nlohmann::json{{"resume", false}, {"config", j}}.dump();
+}
+
+std::string comparable_manifest(nlohmann::json manifest) {
+  manifest.erase("data");  // the dataset's path on each machine
+  return manifest.dump();
+}
+
+// `dist`: null for one process. Rank 0 (or the only process) is the "lead": it alone touches
+// the run folder.
+TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOptions& options,
+                                 Distributed* dist) {
+  const bool lead = !dist || dist->rank() == 0;
   const fs::path run(options.run_dir);
   const std::string config_path = run_file(options.run_dir, "config.json");
   const std::string manifest_path = run_file(options.run_dir, "data.json");
   TrainConfig cfg = config_in;
   std::optional<std::string> resume_from;
   nlohmann::json old_manifest;
-  // One writer per run folder; what a killed writer left half-written goes.
-  const io::FolderLock lock(options.run_dir);
-  io::remove_stale_temporaries(options.run_dir);
-  io::remove_stale_temporaries(infer::checkpoint_dir(options.run_dir));
+  std::unique_ptr<io::FolderLock> lock;
+  if (lead) {
+    // One writer per run folder; what a killed writer left half-written goes.
+    lock = std::make_unique<io::FolderLock>(options.run_dir);
+    io::remove_stale_temporaries(options.run_dir);
+    io::remove_stale_temporaries(infer::checkpoint_dir(options.run_dir));
 
-  if (options.resume) {
-    std::error_code ec;
-    require(fs::is_regular_file(config_path, ec),
-            options.run_dir +
-                ": no config.json here, so there is no run to resume; drop --resume "
-                "to start a new run");
-    cfg = infer::train_config_from_json(io::read_json(config_path), config_path);
-    if (options.steps) infer::set_run_length(cfg, *options.steps);
-    if (options.threads) cfg.threads = *options.threads;
-    if (fs::is_regular_file(manifest_path, ec)) old_manifest = io::read_json(manifest_path);
-    const bool any = !infer::checkpoints_newest_first(options.run_dir).empty();
-    resume_from = newest_intact_checkpoint(options.run_dir);
-    require(resume_from || !any,
-            options.run_dir + ": every checkpoint is damaged; start over with --force");
-    if (!resume_from) warn(options.run_dir + ": no checkpoint yet; starting from step 0");
-  } else if (folder_has_entries(run)) {
-    require(options.force, options.run_dir +
-                               ": folder is not empty; pass --resume to continue this run or "
-                               "--force to start over (deletes its checkpoints)");
-    std::error_code ec;
-    // --force restarts a run; it must not turn any other folder (a dataset, a home folder) into
-    // one.
-    require(
-        fs::exists(config_path, ec) || fs::is_directory(infer::checkpoint_dir(options.run_dir), ec),
-        options.run_dir +
-            ": not a neraf run folder (no config.json or checkpoints/), so --force will not "
-            "train into it; choose a new or empty folder for --out");
-    fs::remove_all(infer::checkpoint_dir(options.run_dir), ec);
-    fs::remove(config_path, ec);
-    fs::remove(manifest_path, ec);
+    if (options.resume) {
+      std::error_code ec;
+      require(fs::is_regular_file(config_path, ec),
+              options.run_dir +
+                  ": no config.json here, so there is no run to resume; drop --resume "
+                  "to start a new run");
+      cfg = infer::train_config_from_json(io::read_json(config_path), config_path);
+      if (options.steps) infer::set_run_length(cfg, *options.steps);
+      if (options.threads) cfg.threads = *options.threads;
+      if (fs::is_regular_file(manifest_path, ec)) old_manifest = io::read_json(manifest_path);
+      const bool any = !infer::checkpoints_newest_first(options.run_dir).empty();
+      resume_from = newest_intact_checkpoint(options.run_dir);
+      require(resume_from || !any,
+              options.run_dir + ": every checkpoint is damaged; start over with --force");
+      if (!resume_from) warn(options.run_dir + ": no checkpoint yet; starting from step 0");
+    } else if (folder_has_entries(run)) {
+      require(options.force, options.run_dir +
+                                 ": folder is not empty; pass --resume to continue this run or "
+                                 "--force to start over (deletes its checkpoints)");
+      std::error_code ec;
+      // --force restarts a run; it must not turn any other folder (a dataset, a home folder)
+      // into one.
+      require(fs::exists(config_path, ec) ||
+                  fs::is_directory(infer::checkpoint_dir(options.run_dir), ec),
+              options.run_dir +
+                  ": not a neraf run folder (no config.json or checkpoints/), so --force will "
+                  "not train into it; choose a new or empty folder for --out");
+      fs::remove_all(infer::checkpoint_dir(options.run_dir), ec);
+      fs::remove(config_path, ec);
+      fs::remove(manifest_path, ec);
+    }
   }
   if (options.save_every) cfg.save_every = *options.save_every;
+  if (dist) {
+    // The ranks agree on the flags (or all resume), then train rank 0's resolved config.
+    dist->check_same_json("flags", "training config", comparable_flags(cfg, options.resume));
+    const std::string rank0 = dist->share_from_rank0("training config", infer::to_json(cfg).dump());
+    if (!lead && options.resume) {
+      cfg = infer::train_config_from_json(nlohmann::json::parse(rank0), "rank 0's config.json");
+      if (options.threads) cfg.threads = *options.threads;
+    }
+    const int W = dist->world_size();
+    if (cfg.modality != Modality::audio)
+      require(cfg.rays_per_batch % W == 0, "--rays " + std::to_string(cfg.rays_per_batch) +
+                                               ": the global batch must split " +
+                                               "evenly over --world-size " + std::to_string(W) +
+                                               "; use a multiple of " + std::to_string(W));
+    if (cfg.modality != Modality::vision)
+      require(cfg.audio.batch_size % W == 0,
+              "--world-size " + std::to_string(W) + ": the audio batch of " +
+                  std::to_string(cfg.audio.batch_size) +
+                  " slices does not split evenly; use a world size that divides it");
+  }
   infer::validate(cfg, "config");
   if (cfg.threads > 0) torch::set_num_threads(cfg.threads);
   torch::manual_seed(cfg.seed);  // anything that still draws from the global generator
@@ -206,6 +251,9 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
   std::unique_ptr<Trainer> trainer;
   std::vector<const data::RirSet*> all_rirs;  // what the calibration stage fits on
   if (multi) {
+    require(!dist,
+            "--world-size: multi-scene runs do not train data-parallel yet; train them in one "
+            "process (without --world-size, or with --world-size 1)");
     std::vector<std::string> dirs = options.scene_data_dirs;
     require(options.data_dir.empty(),
             "--data: this multi-scene run needs one --data per --vision-run (" +
@@ -229,10 +277,17 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
             "--data: given " + std::to_string(options.scene_data_dirs.size()) +
                 " times but one --vision-run; a multi-scene run needs one --vision-run per --data "
                 "(with --modality audio)");
+    if (dist && !lead) {
+      // After rank 0 has loaded its data (a feature cache in a dataset folder shared by the ranks
+      // of one machine is then built once); on resume its data path is the default.
+      const nlohmann::json rank0 =
+          nlohmann::json::parse(dist->share_from_rank0("data manifest", ""));
+      if (data_dir.empty() && rank0.contains("data")) data_dir = rank0["data"];
+    }
     if (data_dir.empty() && old_manifest.contains("data")) data_dir = old_manifest["data"];
     require(!data_dir.empty(), "--data: required (the dataset folder or its transforms.json)");
     data::ImageLoadOptions image_load;
-    image_load.progress = options.progress;
+    image_load.progress = options.progress && lead;
     scenes.emplace_back();
     scenes.front().images = data::load_transforms_json(data_dir, image_load);
     const data::ImageSet& images = scenes.front().images;
@@ -247,33 +302,58 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
     }
     // The acoustic branch's RIRs (features cached next to the dataset) and their manifest.
     if (cfg.modality != Modality::vision) {
-      rirs = std::make_unique<data::RirSet>(load_rirs(cfg, options, data_dir, cfg.audio.max_len));
+      TrainRunOptions quiet_unless_lead = options;
+      quiet_unless_lead.progress = options.progress && lead;
+      rirs = std::make_unique<data::RirSet>(
+          load_rirs(cfg, quiet_unless_lead, data_dir, cfg.audio.max_len));
       if (!old_manifest.is_null() && resume_from && old_manifest.contains("audio"))
         infer::check_audio_manifest(old_manifest["audio"], *rirs, data_dir);
       manifest["audio"] = infer::make_audio_manifest(*rirs);
       all_rirs.push_back(rirs.get());
     }
+    if (dist) {
+      if (lead) dist->share_from_rank0("data manifest", manifest.dump());
+      dist->check_same_json("data", "dataset", comparable_manifest(manifest));
+    }
     trainer = make_trainer(cfg, &images, options.device, rirs.get());
   }
-  if (resume_from) {
+  if (dist) {
+    trainer->set_distributed(dist);
+    // Every rank resumes from rank 0's checkpoint, read by rank 0 (the others need no access
+    // to the run folder).
+    const std::string bytes = dist->share_from_rank0(
+        "checkpoint", lead && resume_from ? io::read_text_file(*resume_from) : std::string());
+    const std::string name =
+        dist->share_from_rank0("checkpoint name", resume_from ? *resume_from : std::string());
+    if (!bytes.empty()) {
+      trainer->load_checkpoint_bytes(bytes, name);
+      resume_from = name;
+    }
+    trainer->broadcast_parameters();
+  } else if (resume_from) {
     trainer->load_checkpoint(*resume_from);
+  }
+  if (lead && resume_from)
     info("resuming " + options.run_dir + " from step " +
          std::to_string(trainer->completed_steps()) + " (" + *resume_from + ")");
+  if (lead) {
+    // Written only once the checkpoint is known to match, so a refused resume leaves the run as
+    // it was.
+    io::write_json_atomically(config_path, infer::to_json(cfg));
+    io::write_json_atomically(manifest_path, manifest);
   }
-  // Written only once the checkpoint is known to match, so a refused resume leaves the run as
-  // it was.
-  io::write_json_atomically(config_path, infer::to_json(cfg));
-  io::write_json_atomically(manifest_path, manifest);
 
   TrainRunSummary summary;
   summary.start_step = trainer->completed_steps();
   summary.end_step = summary.start_step;
   if (summary.start_step >= cfg.steps) {
-    info(options.run_dir + ": already trained to step " + std::to_string(summary.start_step) +
-         "; pass --steps N to train further");
+    if (lead)
+      info(options.run_dir + ": already trained to step " + std::to_string(summary.start_step) +
+           "; pass --steps N to train further");
     if (resume_from) {
       summary.checkpoint = *resume_from;
-      calibrate_if_needed(cfg, options.run_dir, *resume_from, summary.start_step, all_rirs);
+      if (lead)
+        calibrate_if_needed(cfg, options.run_dir, *resume_from, summary.start_step, all_rirs);
     }
     return summary;
   }
@@ -287,11 +367,13 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
                   " train RIRs"
             : std::to_string(scenes.front().images.train.size()) + " train / " +
                   std::to_string(scenes.front().images.eval.size()) + " eval images";
-  info("training " + infer::to_string(cfg.modality) + " (preset " + cfg.preset + ", " + what +
-       ", " + std::to_string(torch::get_num_threads()) + " threads, " +
-       nerf::to_string(cfg.model.precision) + " MLPs) → " + options.run_dir);
+  if (lead)
+    info("training " + infer::to_string(cfg.modality) + " (preset " + cfg.preset + ", " + what +
+         ", " + std::to_string(torch::get_num_threads()) + " threads" +
+         (dist ? " x " + std::to_string(dist->world_size()) + " processes" : std::string()) + ", " +
+         nerf::to_string(cfg.model.precision) + " MLPs) → " + options.run_dir);
   Progress progress("train", cfg.steps - summary.start_step,
-                    ProgressOptions{"step", 0.2, 10.0, options.progress});
+                    ProgressOptions{"step", 0.2, 10.0, options.progress && lead});
   const auto t0 = std::chrono::steady_clock::now();
   std::deque<double> recent_psnr;
   double psnr_sum = 0, audio_decay = 0;
@@ -348,8 +430,14 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
     progress.update(r.step - summary.start_step, status);
 
     const bool done = r.step >= cfg.steps;
-    const bool stop = options.stop && options.stop->load();
-    if (done || stop || r.step % cfg.save_every == 0) {
+    bool stop = options.stop && options.stop->load();
+    if (dist) {
+      // Ctrl-C on any rank stops every rank after the same step (rank 0 saves it).
+      torch::Tensor flag = torch::tensor({stop ? 1.0 : 0.0}, torch::kFloat64);
+      dist->sum(flag);
+      stop = flag.item<double>() > 0;
+    }
+    if (lead && (done || stop || r.step % cfg.save_every == 0)) {
       summary.checkpoint = infer::checkpoint_path(options.run_dir, r.step);
       trainer->save_checkpoint(summary.checkpoint);
       infer::prune_checkpoints(options.run_dir, options.keep);
@@ -361,18 +449,25 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
     if (done) break;
   }
   progress.finish();
+  if (dist) summary.comm = dist->stats();
   if (summary.interrupted) return summary;  // the caller says so (cli: exit 130)
-  calibrate_if_needed(cfg, options.run_dir, summary.checkpoint, summary.end_step, all_rirs);
+  if (lead)
+    calibrate_if_needed(cfg, options.run_dir, summary.checkpoint, summary.end_step, all_rirs);
   return summary;
 }
 
 }  // namespace
 
 TrainRunSummary run_training(const TrainConfig& config, const TrainRunOptions& options) {
+  // The rendezvous comes first, so an unreachable master or a disagreeing world size is found
+  // before any data is read.
+  std::unique_ptr<Distributed> dist;
+  if (options.distributed.enabled()) dist = std::make_unique<Distributed>(options.distributed);
+  if (dist && dist->rank() != 0) return train_run_folder(config, options, dist.get());
   std::error_code ec;
   const bool created = !fs::exists(options.run_dir, ec);
   try {
-    return train_run_folder(config, options);
+    return train_run_folder(config, options, dist.get());
   } catch (...) {
     // A refused or failed run leaves no folder behind that it created and wrote no checkpoint to.
     if (created && infer::checkpoints_newest_first(options.run_dir).empty())

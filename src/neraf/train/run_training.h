@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "neraf/infer/train_config.h"
+#include "neraf/train/distributed.h"
 
 namespace neraf::train {
 
@@ -29,6 +30,11 @@ struct TrainRunOptions {
   bool progress = true;
   const std::atomic<bool>* stop = nullptr;  // set asynchronously (Ctrl-C) → checkpoint and return
   torch::Device device = torch::kCPU;
+  // Data-parallel training (world_size > 1, distributed.h): rank 0 owns the run folder (lock,
+  // config.json, data.json, checkpoints, calibration, progress); the other ranks never touch
+  // it: they take rank 0's config (and on --resume its checkpoint's bytes) over the network and
+  // need only their own copy of the dataset (--data, or rank 0's data path on resume).
+  DistributedConfig distributed;
 };
 
 struct TrainRunSummary {
@@ -41,6 +47,7 @@ struct TrainRunSummary {
   double last_audio_sl = 0;  // audio log-magnitude MSE (running mean; 0 before audio starts)
   bool interrupted = false;
   std::string checkpoint;  // the last checkpoint written
+  CommStats comm;          // distributed: the gradient all-reduces (bytes, time)
 };
 
 // Trains `config` (already resolved from preset + flags) into options.run_dir, holding its lock

@@ -4,12 +4,14 @@
 
 #include <cmath>
 #include <mutex>
+#include <unordered_set>
 
 #include "neraf/infer/checkpoint.h"
 #include "neraf/infer/run.h"
 #include "neraf/nerf/rays.h"
 #include "neraf/nerf/samplers.h"
 #include "neraf/train/audio_branch.h"
+#include "neraf/train/distributed.h"
 #include "neraf/train/lr_schedule.h"
 #include "neraf/util/error.h"
 
@@ -56,8 +58,15 @@ LossDict VisionBranch::losses(StepContext& ctx) {
   const int64_t R = config_.rays_per_batch;
   const int64_t per_image = height_ * width_;
   // Uniform random pixels over all training images (nerfstudio's PixelSampler).
-  const torch::Tensor idx =
-      torch::randint(0, num_images_ * per_image, {R}, ctx.gen, torch::kInt64).to(device_);
+  // Data-parallel: the global batch's pixels are drawn, this rank keeps its rows (and their
+  // jitter, nerf::JitterRows), so the ranks together see exactly one process's batch.
+  torch::Tensor idx = torch::randint(0, num_images_ * per_image, {R}, ctx.gen, torch::kInt64);
+  nerf::JitterRows rows;
+  if (!ctx.shard.whole()) {
+    rows = {R, ctx.shard.begin(R)};
+    idx = idx.narrow(0, rows.begin, ctx.shard.count(R));
+  }
+  idx = idx.to(device_);
   const torch::Tensor img = torch::div(idx, per_image, "floor");
   const torch::Tensor rem = idx - img * per_image;
   const torch::Tensor row = torch::div(rem, width_, "floor");
@@ -78,7 +87,7 @@ LossDict VisionBranch::losses(StepContext& ctx) {
           ? nerf::proposal_weight_anneal(ctx.step, sc.proposal_weights_anneal_slope,
                                          sc.proposal_weights_anneal_max_num_iters)
           : 1.0;
-  const nerf::ModelOutputs out = model_->forward(rays, {pu.update, anneal, &ctx.gen});
+  const nerf::ModelOutputs out = model_->forward(rays, {pu.update, anneal, &ctx.gen, rows});
   LossDict l = model_->losses(out, gt);
   const double mse = l.at("rgb_loss").item<double>();
   ctx.metrics["psnr"] = -10.0 * std::log10(std::max(mse, 1e-12));
@@ -104,6 +113,43 @@ void VisionBranch::load(torch::serialize::InputArchive& archive, const std::stri
 
 // ---------------------------------------------------------------------------------------------
 // Trainer
+
+namespace {
+
+// The ranks' means of the step's loss values and metrics (one small all-reduce); the metrics are
+// replaced in place, the losses returned by name. Every rank has the same names (the branches
+// and their schedules are deterministic).
+std::map<std::string, double> mean_over_ranks(const LossDict& losses,
+                                              std::map<std::string, double>& metrics,
+                                              Distributed& dist) {
+  std::vector<double> values;
+  for (const auto& [k, v] : losses) values.push_back(v.detach().item<double>());
+  for (const auto& [k, v] : metrics) values.push_back(v);
+  std::map<std::string, double> out;
+  if (values.empty()) return out;
+  torch::Tensor t = torch::tensor(values, torch::kFloat64);  // [n_losses + n_metrics]
+  dist.sum(t);
+  t.div_(dist.world_size());
+  const double* p = t.data_ptr<double>();
+  for (const auto& [k, v] : losses) out[k] = *p++;
+  for (auto& [k, v] : metrics) v = *p++;
+  return out;
+}
+
+}  // namespace
+
+void Trainer::set_distributed(Distributed* dist) { dist_ = dist; }
+
+void Trainer::broadcast_parameters() {
+  if (!dist_) return;
+  if (groups_.empty()) build_optimizers();
+  std::unordered_set<const void*> seen;
+  std::vector<torch::Tensor> params;
+  for (const auto& g : groups_)
+    for (const auto& p : g.params)
+      if (seen.insert(p.unsafeGetTensorImpl()).second) params.push_back(p);
+  dist_->broadcast(params);
+}
 
 Trainer::Trainer(TrainConfig config, torch::Device device)
     : config_(std::move(config)),
@@ -158,6 +204,10 @@ StepResult Trainer::step() {
 
   StepResult result;
   StepContext ctx{step_, gen_, result.metrics};
+  if (dist_) {
+    ctx.shard = {dist_->rank(), dist_->world_size()};
+    ctx.dist = dist_;
+  }
   LossDict all;
   for (auto& b : branches_) {
     for (auto& [k, v] : b->losses(ctx)) {
@@ -166,19 +216,32 @@ StepResult Trainer::step() {
     }
     result.rays += b->rays_per_step();
   }
+  // Distributed: the values every rank reports (and checks) are the ranks' means.
+  std::map<std::string, double> reported;
+  if (dist_) reported = mean_over_ranks(all, result.metrics, *dist_);
   if (!all.empty()) {
     torch::Tensor total = torch::zeros({}, all.begin()->second.options());
     for (const auto& [k, v] : all) {
       total = total + v;
-      result.losses[k] = v.item<double>();
+      result.losses[k] = dist_ ? reported.at(k) : v.item<double>();
       if (!std::isfinite(result.losses[k]))
         throw DivergedError("step " + std::to_string(step_ + 1) + ": the loss term '" + k +
                             "' is " + (std::isnan(result.losses[k]) ? "NaN" : "infinite") +
                             " (training diverged)");
     }
     if (total.requires_grad()) total.backward();
+    if (dist_) {
+      std::vector<torch::Tensor> params;
+      for (const auto& g : groups_) params.insert(params.end(), g.params.begin(), g.params.end());
+      dist_->average_gradients(params);
+    }
     for (auto& g : groups_) g.optimizer->step();
-    result.loss = total.item<double>();
+    if (dist_) {
+      result.loss = 0;
+      for (const auto& [k, v] : result.losses) result.loss += v;
+    } else {
+      result.loss = total.item<double>();
+    }
   }
   result.step = ++step_;
   return result;
@@ -213,9 +276,19 @@ void Trainer::save_checkpoint(const std::string& path) {
 }
 
 void Trainer::load_checkpoint(const std::string& path) {
-  if (groups_.empty()) build_optimizers();
   torch::serialize::InputArchive a;
   infer::load_archive(a, path);
+  load_state(a, path);
+}
+
+void Trainer::load_checkpoint_bytes(const std::string& bytes, const std::string& path) {
+  torch::serialize::InputArchive a;
+  infer::load_archive_bytes(a, bytes, path);
+  load_state(a, path);
+}
+
+void Trainer::load_state(torch::serialize::InputArchive& a, const std::string& path) {
+  if (groups_.empty()) build_optimizers();
   infer::check_checkpoint_header(a, config_, path);
   try {
     torch::Tensor step, rng;

@@ -41,11 +41,28 @@ struct ParamGroup {
   infer::ScheduleConfig schedule;
 };
 
+class Distributed;  // distributed.h
+
+// This process's share of a data-parallel step (train/distributed.h): every rank draws the same
+// global batch from the same generator and works on rows [begin, begin + count) of it.
+struct Shard {
+  int rank = 0;
+  int world_size = 1;
+  // Rows of a global batch of n (n must split evenly; checked when the run starts).
+  int64_t begin(int64_t n) const { return n / world_size * rank; }
+  int64_t count(int64_t n) const { return n / world_size; }
+  bool whole() const { return world_size == 1; }
+};
+
 // What a branch sees during a step.
 struct StepContext {
   int64_t step;                            // index of the step being taken (0-based)
   at::Generator& gen;                      // the run's random stream (checkpointed)
   std::map<std::string, double>& metrics;  // scalars to report (e.g. "psnr")
+  Shard shard = {};                        // this rank's rows of the global batch
+  // Sums a small tensor in place over the ranks (losses that are not means over the batch);
+  // null when the run is not distributed.
+  Distributed* dist = nullptr;
 };
 
 class Branch {
@@ -126,6 +143,18 @@ class Trainer {
   // DivergedError (nothing written) when a parameter is not finite.
   void save_checkpoint(const std::string& path);
   void load_checkpoint(const std::string& path);
+  // The same from the file's bytes (`path` names it in errors): a distributed run's ranks load
+  // what rank 0 read.
+  void load_checkpoint_bytes(const std::string& bytes, const std::string& path);
+
+  // Data-parallel training (`dist` outlives the trainer; null: one process): each step works on
+  // this rank's share of the global batch and averages the gradients over the ranks; the
+  // reported losses and metrics are the ranks' means (identical on every rank, so a non-finite
+  // loss stops every rank at the same step).
+  void set_distributed(Distributed* dist);
+  // Rank 0's parameters on every rank (after construction or loading; the ranks build the same
+  // model from the same seed, this makes it certain).
+  void broadcast_parameters();
 
   const infer::TrainConfig& config() const { return config_; }
   void set_total_steps(int64_t steps) { config_.steps = steps; }
@@ -137,6 +166,7 @@ class Trainer {
 
  private:
   void build_optimizers();
+  void load_state(torch::serialize::InputArchive& archive, const std::string& path);
 
   struct Group {
     std::string name;
@@ -151,6 +181,7 @@ class Trainer {
   std::vector<Group> groups_;
   at::Generator gen_;
   int64_t step_ = 0;
+  Distributed* dist_ = nullptr;
 };
 
 // The trainer for `config.modality` with its branches. Vision/joint need `images`; audio/joint
