@@ -178,25 +178,34 @@ class Report:
 
     def plot_methods(self, evals, room, title):
         methods = ["neraf", "neraf_uncalibrated", "nearest", "linear"]
+        self.held_out_and_novel_bars(evals, methods, lambda a, m: a.get(m),
+                                     ["neraf", "neraf\nuncal.", "nearest", "linear"],
+                                     f"{title}: mean error over seeds (± SE)", f"e1_{room}.png",
+                                     f"{title}: errors by method")
+
+    def held_out_and_novel_bars(self, evals, names, row_of, ticks, title, file_name, caption):
+        """One panel per metric, a held-out and a new-positions bar per name (mean ± SE over
+        seeds); row_of(audio_results, name) gives that name's metrics or None."""
         fig, axes = self.plt.subplots(1, len(METRICS), figsize=(11, 3))
         for ax, (metric, label) in zip(axes, METRICS):
             for i, part in enumerate(["audio", "novel"]):
                 ys, es = [], []
-                for m in methods:
-                    xs = [a[m][metric] for a in part_of(evals, part) if m in a]
+                for n in names:
+                    xs = [r.get(metric) for r in (row_of(a, n) for a in part_of(evals, part)) if r]
+                    xs = [x for x in xs if x is not None]
                     ys.append(mean(xs))
                     es.append(se(xs))
-                xs = [j + (i - 0.5) * 0.38 for j in range(len(methods))]
+                xs = [j + (i - 0.5) * 0.38 for j in range(len(names))]
                 ax.bar(xs, [0 if math.isnan(y) else y for y in ys], 0.38,
                        yerr=[0 if math.isnan(e) else e for e in es], capsize=3,
                        label="held-out" if part == "audio" else "new positions")
-            ax.set_xticks(range(len(methods)))
-            ax.set_xticklabels(["neraf", "neraf\nuncal.", "nearest", "linear"], fontsize=8)
+            ax.set_xticks(range(len(names)))
+            ax.set_xticklabels(ticks, fontsize=7)
             ax.set_ylabel(label)
             ax.grid(axis="y", alpha=0.3)
         axes[0].legend(fontsize=8)
-        fig.suptitle(f"{title}: mean error over seeds (± SE)", fontsize=10)
-        self.image(fig, f"e1_{room}.png", f"{title}: errors by method")
+        fig.suptitle(title, fontsize=10)
+        self.image(fig, file_name, caption)
 
     def experiment2(self):
         rooms = [("occluded", "occluded room (partition with a doorway)"),
@@ -242,27 +251,10 @@ class Report:
         names = ["neraf"]
         for a in part_of(evals, "audio"):
             names += [k for k in a.get("ablations", {}) if k not in names]
-        fig, axes = self.plt.subplots(1, len(METRICS), figsize=(11, 3))
-        for ax, (metric, label) in zip(axes, METRICS):
-            for i, part in enumerate(["audio", "novel"]):
-                ys, es = [], []
-                for n in names:
-                    xs = [(a["ablations"][n] if n != "neraf" else a["neraf"]).get(metric)
-                          for a in part_of(evals, part) if n == "neraf" or n in a.get("ablations", {})]
-                    xs = [x for x in xs if x is not None]
-                    ys.append(mean(xs))
-                    es.append(se(xs))
-                xs = [j + (i - 0.5) * 0.38 for j in range(len(names))]
-                ax.bar(xs, [0 if math.isnan(y) else y for y in ys], 0.38,
-                       yerr=[0 if math.isnan(e) else e for e in es], capsize=3,
-                       label="held-out" if part == "audio" else "new positions")
-            ax.set_xticks(range(len(names)))
-            ax.set_xticklabels([n.replace(" ", "\n") for n in names], fontsize=7)
-            ax.set_ylabel(label)
-            ax.grid(axis="y", alpha=0.3)
-        axes[0].legend(fontsize=8)
-        fig.suptitle(f"grid ablation, {title}: mean error over seeds (± SE)", fontsize=10)
-        self.image(fig, f"e2_{room}.png", f"grid ablation, {title}")
+        row_of = lambda a, n: a.get("neraf") if n == "neraf" else a.get("ablations", {}).get(n)
+        self.held_out_and_novel_bars(evals, names, row_of, [n.replace(" ", "\n") for n in names],
+                                     f"grid ablation, {title}: mean error over seeds (± SE)",
+                                     f"e2_{room}.png", f"grid ablation, {title}")
 
     def experiment3(self):
         fractions = ["0.25", "0.5", "0.75", "1"]
