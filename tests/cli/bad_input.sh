@@ -279,17 +279,17 @@ D=""
 fresh run_noconfig run; rm "$D/config.json"
 bad "$D" "$NERAF" eval --run "$D" --json @OUT@ --quiet
 fresh run_badconfig run; echo '{"preset": ' >"$D/config.json"
-bad "$D/config.json" "$NERAF" render view --run "$D" --frame 0 --out @OUT@
+bad "$D/config.json" "$NERAF" render view --run "$D" --frame 0 --out @OUT@.png
 fresh run_confdir run; rm "$D/config.json"; mkdir "$D/config.json"
-bad "$D" "$NERAF" export --run "$D" --out @OUT@
+bad "$D" "$NERAF" export --run "$D" --out @OUT@.nrf
 fresh run_nodata run; rm "$D/data.json"
-bad "$D/data.json" "$NERAF" render view --run "$D" --frame 0 --out @OUT@
+bad "$D/data.json" "$NERAF" render view --run "$D" --frame 0 --out @OUT@.png
 fresh run_baddata run; echo '[1, 2' >"$D/data.json"
 bad "$D/data.json" "$NERAF" eval --run "$D" --json @OUT@ --quiet
 CK=$(ls "$BASE/run/checkpoints/"step-*.pt | grep -v calibration | tail -n 1)
 CK=${CK#"$BASE/run/"}
 fresh run_cut_ckpt run; for f in "$D"/checkpoints/step-*.pt; do cut_half "$f"; done
-bad "$D/checkpoints" "$NERAF" render view --run "$D" --frame 0 --out @OUT@
+bad "$D/checkpoints" "$NERAF" render view --run "$D" --frame 0 --out @OUT@.png
 D=""
 
 # --- model files ----------------------------------------------------------------------------
@@ -382,6 +382,30 @@ got=$?
 classes=$((classes + 1))
 next_out
 check "synth in a deleted working folder" "cannot create files" cmd
+# Another run's checkpoint (a copy of the run elsewhere): refused by every command that takes
+# --checkpoint, and calibrate does not write into the other run.
+cp -r "$BASE/run" "$TMP/other_run"
+OTHER_CK=$(ls "$TMP"/other_run/checkpoints/step-*[0-9].pt | tail -n 1)
+bad "not a checkpoint of the run" "$NERAF" calibrate --run "$BASE/run" --checkpoint "$OTHER_CK"
+bad "not a checkpoint of the run" "$NERAF" eval --run "$BASE/run" --checkpoint "$OTHER_CK" \
+  --json @OUT@ --skip-vision --no-baselines --quiet
+bad "not a checkpoint of the run" "$NERAF" export --run "$BASE/run" --checkpoint "$OTHER_CK" \
+  --out @OUT@.nrf
+bad "not a checkpoint of the run" "$NERAF" render view --run "$BASE/run" --checkpoint "$OTHER_CK" \
+  --frame 0 --out @OUT@.png
+# A room given twice to a multi-scene run, a run as its own ablation, nothing left to evaluate,
+# a pose for a --rir file, outputs named for another format.
+bad "given twice" "$NERAF" train --modality audio --data "$BASE/ss" --data "$BASE/ss/" \
+  --vision-run "$BASE/run" --vision-run "$BASE/run" --out @OUT@ --steps 2 --quiet
+bad "is --run itself" "$NERAF" eval --run "$BASE/run" --ablation-runs "$BASE/run" --json @OUT@ \
+  --skip-vision --no-baselines --quiet
+quiet "$NERAF" train --data "$BASE/ss" --modality vision --out "$TMP/vision_only" --steps 2 \
+  --rays 128 --quiet
+bad "nothing to evaluate" "$NERAF" eval --run "$TMP/vision_only" --json @OUT@ --skip-vision --quiet
+bad "--yaw" "$NERAF" auralize --rir "$WAV" --yaw 90 --in "$DRY" --out @OUT@.wav
+bad ".png" "$NERAF" render view --run "$BASE/run" --frame 0 --out @OUT@.jpg
+bad ".nrf" "$NERAF" export --run "$BASE/run" --out @OUT@.wav
+
 # A mistyped command or option gets a suggestion.
 run "$NERAF" trian --data x
 [ "$got" -eq 2 ] && grep -q "did you mean 'train'" "$TMP/err" ||

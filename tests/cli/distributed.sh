@@ -70,7 +70,7 @@ grep -q "damaged" "$TMP/err" && fail "a damaged checkpoint after the kill: $(cat
 expect_file "$K/checkpoints/step-000000006.pt"
 
 # 4. Ctrl-C (SIGINT) to launch: forwarded once; every rank stops after the same step, rank 0
-# saves it, exit 0.
+# saves it, exit 130 (as train's own after an interrupt).
 I=$TMP/interrupted
 "$NERAF" launch -n 2 -- train --data "$S" --out "$I" --steps 100000 --save-every 100000 \
   "${small[@]}" >"$TMP/i.out" 2>"$TMP/i.err" &
@@ -80,8 +80,8 @@ sleep 2
 kill -INT "$li"
 wait "$li"
 rc=$?
-[ "$rc" -eq 0 ] || fail "launch exited $rc after Ctrl-C: $(cat "$TMP/i.err")"
-expect_in "$TMP/i.err" "interrupted: checkpoint saved at step"
+[ "$rc" -eq 130 ] || fail "launch exited $rc after Ctrl-C, expected 130: $(cat "$TMP/i.err")"
+expect_in "$TMP/i.err" "interrupted: training stopped at step"
 [ "$(find "$I/checkpoints" -name 'step-*[0-9].pt' | wc -l)" -eq 1 ] ||
   fail "expected the one checkpoint of the interrupt: $(ls "$I/checkpoints")"
 

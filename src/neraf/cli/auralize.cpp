@@ -116,11 +116,10 @@ void register_auralize(CLI::App& app) {
     // still usage errors (exit 2).
     const bool field = run_opt->count() > 0 || model_opt->count() > 0;
     if (rir_opt->count() == 0 && !field) throw CLI::RequiredError("--rir, --run or --model");
-    require_safe_output({"--out", args->out_path},
-                        {{"--in", args->dry_path},
-                         {"--rir", args->rir_path},
-                         {"--model", args->field.model}},
-                        args->field.run);
+    require_safe_output(
+        {"--out", args->out_path},
+        {{"--in", args->dry_path}, {"--rir", args->rir_path}, {"--model", args->field.model}},
+        args->field.run);
     if (field) {
       if (pose_opts.first->count() == 0) throw CLI::RequiredError("--mic (with --run/--model)");
       if (pose_opts.second->count() == 0) throw CLI::RequiredError("--src (with --run/--model)");
@@ -131,8 +130,12 @@ void register_auralize(CLI::App& app) {
       auralize_and_write(rir, "rendered from " + loaded.name, args->dry_path, *args);
       return;
     }
-    if (pose_opts.first->count() + pose_opts.second->count() > 0)
-      throw CLI::ValidationError("--mic/--src: only with --run or --model (a field to render)");
+    if (pose_opts.first->count() + pose_opts.second->count() + args->pose.yaw_opt->count() +
+            args->pose.src_yaw_opt->count() >
+        0)
+      throw CLI::ValidationError(
+          "--mic/--src/--yaw/--src-yaw: only with --run or --model (a field to render); a --rir "
+          "file is used as it is");
     const io::AudioBuffer rir = io::read_audio(args->rir_path);
     auralize_and_write(rir, args->rir_path, args->dry_path, *args);
   });

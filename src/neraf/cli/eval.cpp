@@ -240,6 +240,11 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
           "--ablation-runs: needs --run (an exported --model does not record how it was trained, "
           "so the ablations cannot be checked against it)");
   for (const std::string& dir : split_commas(args.ablation_runs)) {
+    std::error_code ec;
+    require(!std::filesystem::equivalent(dir, args.run, ec),
+            "--ablation-runs " + dir +
+                ": is --run itself; give runs trained with one setting "
+                "changed (e.g. --grid zeros)");
     const std::string label = std::filesystem::path(dir).lexically_normal().filename().string();
     require(labels.insert(label).second && label != "neraf" && label != eval::kUncalibratedName &&
                 label != "nearest" && label != "linear",
@@ -410,7 +415,8 @@ void register_eval(CLI::App& app) {
       "the energy calibration and early/late balance fitted on its training RIRs, and\n"
       "\"neraf_uncalibrated\" without, as the linear baseline is rendered (each row states its\n"
       "post-processing). --ablation-runs must have trained exactly as --run but for audio.grid,\n"
-      "audio.grid_resolution, audio.relative_geometry or audio.loss (same modality, preset, steps, seed,\n"
+      "audio.grid_resolution, audio.relative_geometry or audio.loss (same modality, preset, steps, "
+      "seed,\n"
       "data; else refused). Baselines:\n"
       "nearest = the measured RIR of the closest training mic with the same heading and source;\n"
       "linear = inverse-distance blend of the 2-4 closest such training RIRs' magnitudes +\n"
@@ -602,6 +608,10 @@ void register_eval(CLI::App& app) {
                   "field of its own); eval each scene's --vision-run\n");
             return;
           }
+          require(cfg.modality != infer::Modality::vision || !args->skip_vision,
+                  args->run +
+                      ": a vision-only run has no acoustic field, so --skip-vision leaves "
+                      "nothing to evaluate; drop --skip-vision");
           if (cfg.modality != infer::Modality::vision) {
             const infer::AudioRun audio = infer::load_audio_run(
                 args->run, torch::kCPU, args->checkpoint, nerf::parse_precision(args->precision));

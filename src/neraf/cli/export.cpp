@@ -67,6 +67,7 @@ void register_export(CLI::App& app) {
       "demo.nrf --mic 2,1.5,1.75 --src 1.1,1.2,0.9 --yaw 90 --out rir.wav");
   cmd->callback([args] {
     require_safe_output({"--out", args->out_path}, {}, args->run_dir);
+    require_extension({"--out", args->out_path}, ".nrf");
     run_export(*args);
   });
 }

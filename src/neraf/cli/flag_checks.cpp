@@ -1,5 +1,7 @@
 #include "neraf/cli/flag_checks.h"
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <string>
 
@@ -82,6 +84,15 @@ void require_safe_output(const FlagPath& out, const std::vector<FlagPath>& input
   require(!same_file(parent.string(), (run / "checkpoints").string()),
           out.flag + " " + out.path +
               ": is in the run's checkpoints folder; choose an output path outside it");
+}
+
+void require_extension(const FlagPath& out, const std::string& extension) {
+  std::string ext = fs::path(out.path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  if (ext != extension)
+    throw CLI::ValidationError(out.flag + " " + out.path + ": neraf writes this output as " +
+                               extension + "; name it with that extension");
 }
 
 }  // namespace neraf::cli

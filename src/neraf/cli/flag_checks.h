@@ -34,6 +34,10 @@ struct FlagPath {
 void require_safe_output(const FlagPath& out, const std::vector<FlagPath>& inputs,
                          const std::string& run_dir = "");
 
+// Usage error unless `path` ends in `extension` (".png", ".nrf"), case-insensitively: an output
+// named for another format would hold bytes its name does not promise.
+void require_extension(const FlagPath& out, const std::string& extension);
+
 // Most steps a training run may be asked for (the paper preset runs 400001).
 constexpr int64_t kMaxSteps = 100000000;
 

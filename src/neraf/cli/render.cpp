@@ -56,6 +56,8 @@ void add_render_view(CLI::App& render) {
     require(frame->count() + pose->count() == 1, "render view: give --frame I or --pose FILE");
     require_safe_output({"--out", args->out}, {{"--depth", args->depth}}, args->run);
     require_safe_output({"--depth", args->depth}, {}, args->run);
+    require_extension({"--out", args->out}, ".png");
+    if (!args->depth.empty()) require_extension({"--depth", args->depth}, ".png");
     if (args->threads > 0) torch::set_num_threads(args->threads);
     infer::LoadedRun run = infer::load_run(args->run, torch::kCPU, args->checkpoint);
     render::Camera cam;

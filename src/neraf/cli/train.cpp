@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -328,6 +329,13 @@ void register_train(CLI::App& app) {
     train::TrainRunOptions opts;
     if (args->data.size() == 1) opts.data_dir = args->data.front();
     if (args->data.size() > 1) opts.scene_data_dirs = args->data;
+    for (size_t i = 0; i < args->data.size(); ++i)
+      for (size_t j = 0; j < i; ++j) {
+        std::error_code ec;
+        require(!std::filesystem::equivalent(args->data[i], args->data[j], ec),
+                "--data " + args->data[i] + ": given twice (as " + args->data[j] +
+                    "); a multi-scene run takes each room once");
+      }
     opts.run_dir = args->out;
     opts.resume = args->resume;
     opts.force = args->force;

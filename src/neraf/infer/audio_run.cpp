@@ -213,13 +213,7 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
   require(out.run_.manifest.contains("audio"),
           manifest_path + ": no audio manifest; re-run neraf train with --modality joint");
   out.info_ = audio_info_from_manifest(out.run_.manifest["audio"], manifest_path);
-  if (checkpoint.empty()) {
-    const auto latest = latest_checkpoint(run_dir);
-    require(latest.has_value(), run_dir + ": no checkpoint yet; train first");
-    out.run_.checkpoint = *latest;
-  } else {
-    out.run_.checkpoint = checkpoint;
-  }
+  out.run_.checkpoint = checkpoint_of_run(run_dir, checkpoint);
   const AudioRunInfo& info = out.info_;
   acoustic::AcousticModelOptions opts =
       audio_model_options(out.run_.config, info.channels, info.n_freq, info.max_len, info.aabb);

@@ -39,6 +39,24 @@ std::optional<std::string> latest_checkpoint(const std::string& run_dir) {
   return all.front();
 }
 
+std::string checkpoint_of_run(const std::string& run_dir, const std::string& checkpoint) {
+  if (checkpoint.empty()) {
+    const auto latest = latest_checkpoint(run_dir);
+    require(latest.has_value(),
+            run_dir + ": no checkpoint yet; train first (neraf train --out " + run_dir + ")");
+    return *latest;
+  }
+  std::error_code ec;
+  const fs::path parent = fs::absolute(checkpoint, ec).parent_path();
+  require(fs::is_regular_file(checkpoint, ec),
+          "--checkpoint " + checkpoint + ": no such file; pick one of " + checkpoint_dir(run_dir));
+  require(fs::equivalent(parent, checkpoint_dir(run_dir), ec),
+          "--checkpoint " + checkpoint + ": not a checkpoint of the run " + run_dir +
+              " (it must be in " + checkpoint_dir(run_dir) +
+              "); pass that checkpoint's own run with --run");
+  return checkpoint;
+}
+
 namespace {
 constexpr const char* kSealMagic = "NERAFCKP";
 constexpr uint32_t kSealVersion = 1;

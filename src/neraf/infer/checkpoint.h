@@ -25,6 +25,11 @@ std::string checkpoint_dir(const std::string& run_dir);                 // RUN/c
 std::string checkpoint_path(const std::string& run_dir, int64_t step);  // .../step-000001000.pt
 // The highest-step checkpoint in RUN/checkpoints, if any.
 std::optional<std::string> latest_checkpoint(const std::string& run_dir);
+// The checkpoint a command reads from the run: `checkpoint` (--checkpoint) when given, which must
+// be one of RUN/checkpoints (another run's, even of the same config, would be read with this
+// run's data and calibration, and calibrate would overwrite that run's calibration), else the
+// latest. neraf::Error otherwise.
+std::string checkpoint_of_run(const std::string& run_dir, const std::string& checkpoint);
 // Every checkpoint in RUN/checkpoints, highest step first.
 std::vector<std::string> checkpoints_newest_first(const std::string& run_dir);
 // Deletes all but the `keep` newest checkpoints (and their calibrations); keep ≤ 0 keeps all.

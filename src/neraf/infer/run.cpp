@@ -252,14 +252,7 @@ LoadedRun load_run(const std::string& run_dir, torch::Device device,
               "scenes' vision runs (audio.vision_runs in its config.json)");
   require(run.manifest.value("format", "") == kManifestFormat && run.manifest.contains("num_train"),
           manifest_path + ": not a neraf run data manifest; re-run neraf train");
-  if (checkpoint.empty()) {
-    const auto latest = latest_checkpoint(run_dir);
-    require(latest.has_value(),
-            run_dir + ": no checkpoint yet; train first (neraf train --out " + run_dir + ")");
-    run.checkpoint = *latest;
-  } else {
-    run.checkpoint = checkpoint;
-  }
+  run.checkpoint = checkpoint_of_run(run_dir, checkpoint);
   if (run.config.model.precision == nerf::Precision::bf16 && !nerf::cpu_supports_bf16())
     run.config.model.precision = nerf::Precision::fp32;  // same weights, no slow bf16 emulation
   run.model = nerf::NerfactoModel(run.config.model, run.manifest["num_train"].get<int64_t>(),

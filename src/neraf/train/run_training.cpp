@@ -202,17 +202,17 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
               options.run_dir + ": every checkpoint is damaged; start over with --force");
       if (!resume_from) warn(options.run_dir + ": no checkpoint yet; starting from step 0");
     } else if (folder_has_entries(run)) {
-      require(options.force, options.run_dir +
-                                 ": folder is not empty; pass --resume to continue this run or "
-                                 "--force to start over (deletes its checkpoints)");
       std::error_code ec;
       // --force restarts a run; it must not turn any other folder (a dataset, a home folder)
       // into one.
       require(fs::exists(config_path, ec) ||
                   fs::is_directory(infer::checkpoint_dir(options.run_dir), ec),
               options.run_dir +
-                  ": not a neraf run folder (no config.json or checkpoints/), so --force will "
-                  "not train into it; choose a new or empty folder for --out");
+                  ": not empty and not a neraf run folder (no config.json or checkpoints/); "
+                  "choose a new or empty folder for --out");
+      require(options.force, options.run_dir +
+                                 ": holds a run; pass --resume to continue it or --force to "
+                                 "start over (deletes its checkpoints)");
       fs::remove_all(infer::checkpoint_dir(options.run_dir), ec);
       fs::remove(config_path, ec);
       fs::remove(manifest_path, ec);
@@ -239,7 +239,7 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
                   std::to_string(cfg.audio.batch_size) +
                   " slices does not split evenly; use a world size that divides it");
   }
-  infer::validate(cfg, "config");
+  infer::validate(cfg, options.resume ? config_path : "config");
   if (cfg.threads > 0) torch::set_num_threads(cfg.threads);
   torch::manual_seed(cfg.seed);  // anything that still draws from the global generator
 
