@@ -193,6 +193,29 @@ struct EvalField {
   int64_t scene = -1;
 };
 
+// What eval scores of a trained run (scene: −1, or a multi-scene run's scene).
+EvalField eval_field_of_run(const infer::AudioRun& run, const infer::AudioRun* uncalibrated,
+                            int64_t scene = -1) {
+  const infer::AudioConfig& a = run.run().config.audio;
+  return {run,
+          run.run().manifest,
+          run.run().config.seed,
+          a.fraction,
+          a.grid,
+          {a.cache_dir, a.cache_precision, a.max_len},
+          post_processing_of(run),
+          uncalibrated,
+          &run,
+          scene};
+}
+
+// One row of the printed summary: "  name  T60 … C50 … EDT … STFT …".
+void print_metrics_row(const std::string& name, const nlohmann::json& v) {
+  auto num = [&v](const char* key) { return v[key].is_number() ? v[key].get<double>() : NAN; };
+  std::printf("  %-20s T60 %8.3f %%  C50 %7.3f dB  EDT %8.5f s  STFT %7.4f\n", name.c_str(),
+              num("t60_error_pct"), num("c50_error_db"), num("edt_error_s"), num("stft_error"));
+}
+
 // Refuses an ablation run whose training differs from the main run's in anything but the
 // ablation knobs (eval::training_difference), whose checkpoint is at another step, or which
 // lacks the calibration the main run has: its numbers would not measure the ablated option.
@@ -558,18 +581,8 @@ void register_eval(CLI::App& app) {
                 uncalibrated =
                     infer::load_audio_run(args->run, torch::kCPU, args->checkpoint,
                                           nerf::parse_precision(args->precision), false, scene);
-              const EvalField source{
-                  run,
-                  run.run().manifest,
-                  run.run().config.seed,
-                  run.run().config.audio.fraction,
-                  run.run().config.audio.grid,
-                  {run.run().config.audio.cache_dir, run.run().config.audio.cache_precision,
-                   run.run().config.audio.max_len},
-                  post_processing_of(run),
-                  uncalibrated ? &*uncalibrated : nullptr,
-                  &run,
-                  scene};
+              const EvalField source =
+                  eval_field_of_run(run, uncalibrated ? &*uncalibrated : nullptr, scene);
               const OutputDir sub{(std::filesystem::path(tmp) / names[k]).string(),
                                   (std::filesystem::path(shown) / names[k]).string()};
               std::filesystem::create_directories(sub.written);
@@ -587,21 +600,9 @@ void register_eval(CLI::App& app) {
             const nlohmann::json& m = audio["mean"];
             std::printf("mean over %zu scenes (each scene counts once):\n", names.size());
             for (const auto& [name, v] : m.items())
-              if (v.contains("t60_error_pct"))
-                std::printf("  %-20s T60 %8.3f %%  C50 %7.3f dB  EDT %8.5f s  STFT %7.4f\n",
-                            name.c_str(),
-                            v["t60_error_pct"].is_number() ? v["t60_error_pct"].get<double>() : NAN,
-                            v["c50_error_db"].is_number() ? v["c50_error_db"].get<double>() : NAN,
-                            v["edt_error_s"].is_number() ? v["edt_error_s"].get<double>() : NAN,
-                            v["stft_error"].is_number() ? v["stft_error"].get<double>() : NAN);
+              if (v.contains("t60_error_pct")) print_metrics_row(name, v);
             if (m.contains("ablations"))
-              for (const auto& [name, v] : m["ablations"].items())
-                std::printf("  %-20s T60 %8.3f %%  C50 %7.3f dB  EDT %8.5f s  STFT %7.4f\n",
-                            name.c_str(),
-                            v["t60_error_pct"].is_number() ? v["t60_error_pct"].get<double>() : NAN,
-                            v["c50_error_db"].is_number() ? v["c50_error_db"].get<double>() : NAN,
-                            v["edt_error_s"].is_number() ? v["edt_error_s"].get<double>() : NAN,
-                            v["stft_error"].is_number() ? v["stft_error"].get<double>() : NAN);
+              for (const auto& [name, v] : m["ablations"].items()) print_metrics_row(name, v);
             if (!args->skip_vision)
               std::printf(
                   "vision: not scored for a multi-scene acoustic run (it has no radiance "
@@ -625,17 +626,8 @@ void register_eval(CLI::App& app) {
               uncalibrated = infer::load_audio_run(args->run, torch::kCPU, args->checkpoint,
                                                    nerf::parse_precision(args->precision),
                                                    /*calibrated=*/false);
-            const EvalField source{
-                audio,
-                audio.run().manifest,
-                audio.run().config.seed,
-                audio.run().config.audio.fraction,
-                audio.run().config.audio.grid,
-                {audio.run().config.audio.cache_dir, audio.run().config.audio.cache_precision,
-                 audio.run().config.audio.max_len},
-                post_processing_of(audio),
-                uncalibrated ? &*uncalibrated : nullptr,
-                &audio};
+            const EvalField source =
+                eval_field_of_run(audio, uncalibrated ? &*uncalibrated : nullptr);
             out["audio"] = evaluate_audio_json(source, *args, dir);
           }
           if (!args->skip_vision) {
