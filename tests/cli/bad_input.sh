@@ -372,6 +372,10 @@ bad "appears twice" "$NERAF" synth --scene "$TMP/twice.json" --out @OUT@ --quiet
 bad "not a neraf run folder" "$NERAF" train --data "$BASE/ss" --out "$BASE/ss/images" --force \
   --steps 2 --audio-start-step 1 --quiet
 [ -e "$BASE/ss/images/config.json" ] && fail "train --force wrote into a dataset's images folder"
+# ... and synth --force replaces only a dataset synth wrote, never a run.
+bad "not a dataset written by neraf synth" "$NERAF" synth --preset demo --layout raf \
+  --out "$BASE/run" --force --quiet
+[ -e "$BASE/run/config.json" ] || fail "synth --force deleted a run"
 long=$(printf 'n%.0s' $(seq 1 250))
 bad "shorter name" "$NERAF" synth --preset demo --layout raf --out "$TMP/$long" --quiet
 bad "/proc" "$NERAF" export --run "$BASE/run" --out /proc/neraf_model.nrf

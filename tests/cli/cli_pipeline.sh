@@ -79,7 +79,14 @@ expect_in "$TMP/err" "--gain-from"
 expect_exit 2 "$NERAF" synth --preset demo --gain-from "$TMP/no-such-set" --out "$TMP/x" --quiet
 expect_exit 0 "$NERAF" synth --preset demo --layout raf --out "$TMP/raf" --seed 4 --quiet
 expect_exit 1 "$NERAF" eval --run "$R" --json "$TMP/x.json" --skip-vision --novel-data "$TMP/raf"
-expect_in "$TMP/err" "differs from the run's"
+expect_in "$TMP/err" "is not a soundspaces dataset as the run's is"
+[ ! -e "$TMP/raf/.neraf_cache" ] || fail "a refused --novel-data was left a feature cache"
+# Another room, even at the run's gain, is not new positions of the run's room.
+expect_exit 0 "$NERAF" synth --preset small_dead --layout soundspaces --mics random --mic-count 2 \
+  --out "$TMP/other_room" --seed 4 --gain-from "$S" --quiet
+expect_exit 1 "$NERAF" eval --run "$R" --json "$TMP/x.json" --skip-vision \
+  --novel-data "$TMP/other_room"
+expect_in "$TMP/err" "is another room than the run's data"
 expect_exit 1 "$NERAF" synth --preset demo --mic-count 3 --out "$TMP/x" --quiet
 expect_in "$TMP/err" "--mics random"
 expect_exit 1 "$NERAF" eval --run "$TMP/no-such-run" --json "$TMP/x.json"

@@ -141,5 +141,9 @@ wait "$f0"
 expect_exit 1 "$NERAF" launch -n 2 -- train --data "$S" --out "$B" --rays 255 --threads 1 --quiet
 expect_in "$TMP/err" "--rays 255: the global batch must split evenly over --world-size 2"
 [ -e "$B" ] && fail "a refused distributed run left $B behind"
+# More threads in all than cores is warned about (launch alone gives each cores / N).
+expect_exit 1 "$NERAF" launch -n 2 -- train --data "$S" --out "$B" --rays 255 --threads "$(nproc)" \
+  --quiet
+expect_in "$TMP/err" "warning: launch: 2 processes x $(nproc) threads"
 
 finish distributed

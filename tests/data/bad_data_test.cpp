@@ -202,6 +202,32 @@ TEST(BadData, DuplicateFramesInTransformsJson) {
   expect_rejected(img.path(), "transforms.json", "lists the same image as frames[1]");
 }
 
+// A focal length written as a string is a value of the wrong type, said once, not "no fl_x" for
+// every frame.
+TEST(BadData, IntrinsicOfTheWrongType) {
+  TempDir img;
+  NerfstudioScene().write(img.path());
+  std::string text = NerfstudioScene().json_text();
+  const std::string focal = "\"fl_x\": 10.0";
+  text.replace(text.find(focal), focal.size(), "\"fl_x\": \"abc\"");
+  testing::write_text(img / "transforms.json", text);
+  expect_rejected(img.path(), "transforms.json", "\"fl_x\" is not a number (\"abc\")");
+  const std::string all = all_text(validate_dataset(img.path()));
+  EXPECT_EQ(all.find("no fl_x"), std::string::npos) << all;
+}
+
+// A RIR that is a symlink to a device (or a FIFO) is not a missing file: it is named as what it is.
+TEST(BadData, RirThatIsNotARegularFile) {
+  Raf raf;
+  fs::remove(raf.wav(1));
+  fs::create_symlink("/dev/zero", raf.wav(1));
+  expect_rejected(raf.dir.path(), "data/000001/rir.wav", "is not a regular file");
+  SoundSpaces ss;
+  fs::remove(ss.wav(0));
+  fs::create_symlink("/dev/zero", ss.wav(0));
+  expect_rejected(ss.dir.path(), "binaural_rirs/0/0_1.wav", "is not a regular file");
+}
+
 TEST(BadData, PngCutInHalf) {
   TempDir img;
   NerfstudioScene scene;

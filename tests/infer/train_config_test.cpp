@@ -10,6 +10,7 @@
 #include "neraf/data/rir_set.h"
 #include "neraf/infer/audio_run.h"
 #include "neraf/util/error.h"
+#include "neraf/util/number_text.h"
 
 namespace neraf::infer {
 namespace {
@@ -274,6 +275,21 @@ TEST(TrainConfig, GridResolutionMustPassTheSceneEncoder) {
   c.audio.grid_resolution = 16;
   c.audio.grid = "none";  // no encoder
   EXPECT_NO_THROW(validate(c, "config.json"));
+}
+
+// A config.json edited to a million threads is refused as the flag is (4 x the cores at most).
+TEST(TrainConfig, ThreadsAreBoundedAsTheFlag) {
+  TrainConfig c = train_preset("cpu");
+  c.threads = max_thread_count();
+  EXPECT_NO_THROW(validate(c, "config.json"));
+  c.threads = 1000000;
+  try {
+    validate(c, "config.json");
+    ADD_FAILURE() << "a million threads must be refused";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("config.json.threads: must be from 0"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(ResolveTrainConfig, UnknownPresetIsAnError) {

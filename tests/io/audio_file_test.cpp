@@ -351,6 +351,23 @@ TEST_F(AudioFileTest, HeaderPromisingMoreSamplesThanPresentIsTruncated) {
   expect_error([&] { neraf::io::read_audio_info(p); }, {p, "truncated"});
 }
 
+// A WAV written to a pipe (`espeak-ng --stdout`, SoX) cannot seek back to fill in its sizes and
+// declares 0x7FFFF000 or 0xFFFFFFFF bytes: streamed audio, read as what is there.
+TEST_F(AudioFileTest, StreamedWavSizePlaceholdersAreNotTruncation) {
+  const std::string good = path("good.wav");
+  neraf::io::write_audio(good, random_audio(1, 300, 22050, 4));
+  std::ifstream in(good, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  const size_t data = bytes.find("data");
+  ASSERT_NE(data, std::string::npos);
+  for (const uint32_t placeholder : {0x7FFFF000u, 0x7FFFFFFFu, 0xFFFFFFFFu}) {
+    for (int b = 0; b < 4; ++b) bytes[data + 4 + b] = static_cast<char>(placeholder >> (8 * b));
+    const std::string p = path("streamed.wav");
+    std::ofstream(p, std::ios::binary) << bytes;
+    EXPECT_EQ(neraf::io::read_audio(p).channels[0].size(), 300u) << std::hex << placeholder;
+  }
+}
+
 TEST_F(AudioFileTest, InfoReadsTheHeaderOnly) {
   const std::string p = path("a.flac");
   neraf::io::write_audio(p, random_audio(2, 1234, 22050, 6));

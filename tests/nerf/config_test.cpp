@@ -59,6 +59,19 @@ TEST(NerfConfig, PartialJsonOverridesAndBadJsonIsAnError) {
                neraf::Error);
   EXPECT_THROW(config_from_json(nlohmann::json::parse(R"({"field": {"hidden_dim": 1.5}})"), c, "x"),
                neraf::Error);
+  // An integer too large for its field (or written as 1e30) names the range, never wraps.
+  for (const char* big :
+       {R"({"field": {"hidden_dim": 1e30}})", R"({"field": {"hidden_dim": 3000000000}})",
+        R"({"field": {"hidden_dim": -3000000000}})"}) {
+    try {
+      config_from_json(nlohmann::json::parse(big), c, "x.json");
+      FAIL() << big;
+    } catch (const neraf::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("x.json.field.hidden_dim: expected an integer from "),
+                std::string::npos)
+          << e.what();
+    }
+  }
   ModelConfig bad = model_preset("paper");
   bad.sampler.proposal_samples = {64};
   EXPECT_THROW(validate(bad, "bad"), neraf::Error);

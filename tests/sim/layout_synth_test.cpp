@@ -313,8 +313,21 @@ TEST(LayoutSynth, RefusesANonEmptyFolderUnlessForced) {
     EXPECT_NE(std::string(e.what()).find("--force"), std::string::npos);
   }
   EXPECT_FALSE(fs::exists(out / "data"));
+  // --force replaces only a dataset synth wrote (not a run, real data or a home folder).
   SynthOptions forced = options(out, 1, "raf");
   forced.force = true;
+  try {
+    synthesize(scene, forced);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("is not a dataset written by neraf synth"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_TRUE(fs::exists(out / "notes.txt"));
+  fs::remove(out / "notes.txt");
+  EXPECT_NO_THROW(synthesize(scene, options(out, 1, "raf")));
+  io::write_text_atomically((out / "notes.txt").string(), "keep me");
   EXPECT_NO_THROW(synthesize(scene, forced));
   EXPECT_TRUE(fs::exists(out / "data/000000/rir.wav"));
   EXPECT_FALSE(fs::exists(out / "notes.txt"));  // --force replaces the folder as a whole

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "../infer/audio_test_util.h"
+#include "neraf/infer/audio_run.h"
 #include "neraf/infer/checkpoint.h"
 #include "neraf/train/trainer.h"
 #include "neraf/util/error.h"
@@ -110,6 +111,17 @@ TEST(AudioBranch, MismatchedDatasetOrPresetIsAClearError) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("another RIR dataset"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("hash"), std::string::npos) << e.what();
+  }
+  // A manifest value of another type is a damaged run, not another dataset.
+  nlohmann::json manifest = infer::make_audio_manifest(rirs);
+  EXPECT_NO_THROW(infer::check_audio_manifest(manifest, rirs, dir));
+  manifest["num_rirs"] = std::to_string(manifest["num_rirs"].get<int64_t>());
+  try {
+    infer::check_audio_manifest(manifest, rirs, dir);
+    FAIL() << "expected neraf::Error";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("the run's data.json is damaged (audio.num_rirs", 0), 0u)
+        << e.what();
   }
   // Another preset (or grid mode) is refused by the header check.
   torch::serialize::InputArchive arch;

@@ -162,9 +162,15 @@ data::RirSet load_rirs(const std::string& dir, bool progress, const CacheChoice&
   return data::load_rir_set(dir, load);
 }
 
-// Simulated sets record the scale their RIRs were written at (synth_info.json). A set at another
-// scale would bias the STFT error (the other metrics are scale-free), so it is refused.
-void check_same_gain(const std::string& run_data_dir, const std::string& novel_dir) {
+// --novel-data must be the run's room heard at other positions. Simulated sets record their room
+// (scene.json) and the scale their RIRs were written at (synth_info.json); another scale would
+// bias the STFT error (the other metrics are scale-free).
+void check_same_room(const std::string& run_data_dir, const std::string& novel_dir) {
+  if (const std::optional<std::string> differs = sim::room_difference(run_data_dir, novel_dir))
+    throw Error(novel_dir + ": is another room than the run's data " + run_data_dir + " (" +
+                *differs +
+                " differs in scene.json); --novel-data takes the run's room heard at other "
+                "microphone positions");
   const std::optional<double> expected = sim::synthesized_gain(run_data_dir),
                               got = sim::synthesized_gain(novel_dir);
   if (!expected || !got) return;
@@ -296,14 +302,17 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
   // Checked before anything is scored or written.
   std::optional<data::RirSet> novel;
   if (!args.novel_data.empty()) {
-    // Cut or padded to the run's frames, whatever the set's own automatic value would be (a set
-    // of the other layout loads as it is, for the format check below to name what differs).
+    // Refused before its features are computed (no cache is left in a set that is refused).
     const data::DatasetLayout layout = data::detect_layout(args.novel_data);
     const bool same_layout =
         rirs.layout == data::AudioLayout::soundspaces ? layout.soundspaces : layout.raf;
-    novel = load_rirs(args.novel_data, !args.quiet, cache, same_layout ? rirs.max_len : 0);
+    require(same_layout, args.novel_data + ": is not a " + data::to_string(rirs.layout) +
+                             " dataset as the run's is; synthesise or convert it in the run's "
+                             "format");
+    check_same_room(data_dir, args.novel_data);
+    // Cut or padded to the run's frames, whatever the set's own automatic value would be.
+    novel = load_rirs(args.novel_data, !args.quiet, cache, rirs.max_len);
     infer::check_same_room_format(source.manifest.at("audio"), *novel, args.novel_data);
-    check_same_gain(data_dir, args.novel_data);
   }
   auto first_rirs = [&](std::vector<int64_t> rirs_to_score) {  // --max-rirs
     if (args.max_rirs >= 0 && static_cast<int64_t>(rirs_to_score.size()) > args.max_rirs)

@@ -16,11 +16,14 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "neraf/cli/commands.h"
@@ -117,6 +120,26 @@ int run_launch(const LaunchArgs& args) {
   const int port = args.master_port > 0 ? args.master_port : free_port();
   bool quiet_given = false;
   for (const auto& a : args.command) quiet_given |= a == "--quiet";
+  // Threads per process: the given --threads (checked by train), else the cores shared out, as
+  // torchrun does; more threads than cores in all makes every rank wait on the others.
+  const int cores = std::max(1u, std::thread::hardware_concurrency());
+  std::vector<std::string> command = args.command;
+  int threads = 0;
+  for (size_t i = 0; i < command.size(); ++i) {
+    if (command[i] == "--threads" && i + 1 < command.size())
+      threads = std::atoi(command[i + 1].c_str());
+    else if (command[i].rfind("--threads=", 0) == 0)
+      threads = std::atoi(command[i].c_str() + 10);
+  }
+  if (threads == 0) {
+    threads = std::max(1, cores / args.nproc);
+    command.insert(command.end(), {"--threads", std::to_string(threads)});
+  }
+  if (args.nproc * threads > cores)
+    std::fprintf(stderr,
+                 "warning: launch: %d processes x %d threads = %d threads on %d cores; the ranks "
+                 "will wait on each other (give each --threads %d)\n",
+                 args.nproc, threads, args.nproc * threads, cores, std::max(1, cores / args.nproc));
 
   train::InterruptGuard interrupt;  // Ctrl-C / SIGTERM → forwarded to the children
   std::vector<Child> children(static_cast<size_t>(args.nproc));
@@ -124,7 +147,7 @@ int run_launch(const LaunchArgs& args) {
     Child& c = children[static_cast<size_t>(r)];
     c.rank = r;
     std::vector<std::string> argv = {"neraf"};
-    argv.insert(argv.end(), args.command.begin(), args.command.end());
+    argv.insert(argv.end(), command.begin(), command.end());
     argv.insert(argv.end(), {"--world-size", std::to_string(args.nproc), "--rank",
                              std::to_string(r), "--master", "127.0.0.1:" + std::to_string(port)});
     int pipe_fds[2] = {-1, -1};
@@ -211,11 +234,12 @@ void register_launch(CLI::App& app) {
       "on this machine. Every process draws the same global batch and trains on its own share;\n"
       "the gradients are averaged (all-reduce), so N processes train what one would, with the\n"
       "same --rays. Rank 0 writes the run folder and the progress bar; the other ranks' lines\n"
-      "are prefixed [rank i]. Give each process --threads T (N x T <= the cores). Ctrl-C stops\n"
-      "every rank after the same step with a checkpoint; if one rank fails the others are\n"
-      "stopped and launch exits non-zero. For several machines run `neraf train` with those\n"
-      "flags on each (README, \"Several processes or machines\").\n"
-      "Example: neraf launch -n 2 -- train --data demo/ --out runs/demo --threads 1");
+      "are prefixed [rank i]. Each process gets --threads T (default: the cores / N; N x T above\n"
+      "the cores is warned about). Ctrl-C stops every rank after the same step with a\n"
+      "checkpoint; if one rank fails the others are stopped and launch exits non-zero. For\n"
+      "several machines run `neraf train` with those flags on each (README, \"Several\n"
+      "processes or machines\").\n"
+      "Example: neraf launch -n 2 -- train --data demo/ --out runs/demo");
   cmd->add_option("-n,--nproc", args->nproc, "Number of processes (ranks)")
       ->transform(whole_number(1, 64))
       ->required();

@@ -285,6 +285,12 @@ Parsed parse(const std::string& path_in, const ImageLoadOptions& options, Proble
     problems.error(file, "\"frames\" is empty", "list at least one posed image");
     return out;
   }
+  // A value of the wrong type is reported as such (once for a global one), not as missing.
+  for (const char* key : {"fl_x", "fl_y", "cx", "cy", "w", "h", "k1", "k2", "k3", "k4", "p1", "p2"})
+    if (meta.contains(key) && !meta[key].is_number())
+      problems.error(file,
+                     std::string("\"") + key + "\" is not a number (" + meta[key].dump() + ")",
+                     "write it as a number of pixels (or a coefficient) without quotes");
   for (size_t i = 0; i < frames.size(); ++i) {
     const json& fr = frames[i];
     Frame f;
@@ -307,8 +313,13 @@ Parsed parse(const std::string& path_in, const ImageLoadOptions& options, Proble
                             {"cx", &f.intr.cx},
                             {"cy", &f.intr.cy}}) {
       if (!get(key, *dst)) {
-        problems.error(file, frame_name(f) + ": no " + key,
-                       std::string("set \"") + key + "\" globally or in every frame");
+        if (fr.contains(key) && !meta.contains(key))
+          problems.error(
+              file, frame_name(f) + ": \"" + key + "\" is not a number (" + fr[key].dump() + ")",
+              "write it as a number of pixels without quotes");
+        else if (!meta.contains(key))
+          problems.error(file, frame_name(f) + ": no " + key,
+                         std::string("set \"") + key + "\" globally or in every frame");
         ok = false;
       }
     }

@@ -153,6 +153,11 @@ RirIndex index_raf(const std::string& dir, ProblemList& problems) {
       rir.id = id;
       rir.wav_path = (fs::path(folder) / "rir.wav").string();
       const FileStamp w = stamp(rir.wav_path);
+      if (w.not_regular) {
+        problems.error(rir.wav_path, "is not a regular file (a device, a pipe or a folder?)",
+                       "replace it with the RIR's wav file");
+        continue;
+      }
       if (!w.exists) {
         problems.error(rir.wav_path, "split entry " + where + " \"" + id + "\" has no rir.wav",
                        "restore the file or remove the id from " + split_path);

@@ -12,7 +12,8 @@
 namespace neraf::data::detail {
 
 struct FileStamp {
-  bool exists = false;
+  bool exists = false;       // a regular file (symlinks followed)
+  bool not_regular = false;  // something else is there: a device, a FIFO, a folder
   int64_t size = 0;
   int64_t mtime_ns = 0;
 };

@@ -63,7 +63,11 @@ namespace detail {
 FileStamp stamp(const std::string& path) {
   struct stat st {};
   FileStamp s;
-  if (::stat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return s;
+  if (::stat(path.c_str(), &st) != 0) return s;
+  if (!S_ISREG(st.st_mode)) {
+    s.not_regular = true;
+    return s;
+  }
   s.exists = true;
   s.size = static_cast<int64_t>(st.st_size);
   s.mtime_ns = static_cast<int64_t>(st.st_mtim.tv_sec) * 1000000000LL + st.st_mtim.tv_nsec;

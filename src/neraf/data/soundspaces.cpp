@@ -216,6 +216,11 @@ RirIndex index_soundspaces(const std::string& dir, bool use_magnitude_files,
       rir.raw_yaw_deg = rot;
       rir.rot = encode_heading(rot);
       const FileStamp w = stamp(rir.wav_path);
+      if (w.not_regular) {
+        problems.error(rir.wav_path, "is not a regular file (a device, a pipe or a folder?)",
+                       "replace it with the RIR's wav file");
+        continue;
+      }
       if (!w.exists) {
         problems.error(rir.wav_path, "split entry " + where + " \"" + entry + "\" has no file",
                        "restore the wav or remove the entry from " + split_path);

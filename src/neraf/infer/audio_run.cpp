@@ -102,11 +102,19 @@ void check_audio_manifest(const nlohmann::json& manifest, const data::RirSet& ri
                           const std::string& where) {
   const nlohmann::json now = make_audio_manifest(rirs);
   for (const char* key :
-       {"layout", "num_rirs", "num_train", "hash", "channels", "n_freq", "max_len"})
-    require(manifest.value(key, nlohmann::json()) == now[key],
-            where + ": was trained on another RIR dataset (" + key + " differs: " +
-                manifest.value(key, nlohmann::json()).dump() + " vs " + now[key].dump() +
+       {"layout", "num_rirs", "num_train", "hash", "channels", "n_freq", "max_len"}) {
+    // A value of another JSON type is a damaged run, not another dataset.
+    const nlohmann::json& was = manifest.value(key, nlohmann::json());
+    require(was.is_null() || was.type() == now[key].type() ||
+                (was.is_number_integer() && now[key].is_number_integer()),
+            std::string("the run's data.json is damaged (audio.") + key + " is " + was.dump() +
+                ", a " + was.type_name() + "; expected a " + now[key].type_name() +
+                "); restore it or train a new run");
+    require(was == now[key],
+            where + ": was trained on another RIR dataset (" + key + " differs: " + was.dump() +
+                " vs " + now[key].dump() +
                 "); use the original --data (or, for neraf train, a new --out folder)");
+  }
 }
 
 void check_same_room_format(const nlohmann::json& manifest, const data::RirSet& rirs,

@@ -8,6 +8,7 @@
 #include "neraf/acoustic/losses.h"
 #include "neraf/nerf/config_io.h"
 #include "neraf/util/error.h"
+#include "neraf/util/number_text.h"
 
 namespace neraf::infer {
 
@@ -181,7 +182,9 @@ void check_schedule(const ScheduleConfig& s, const std::string& where) {
 void validate(const TrainConfig& c, const std::string& where) {
   require(c.steps >= 1, where + ".steps: must be at least 1 (--steps)");
   require(c.rays_per_batch >= 1, where + ".rays_per_batch: must be at least 1");
-  require(c.threads >= 0, where + ".threads: must be >= 0 (--threads)");
+  require(c.threads >= 0 && c.threads <= max_thread_count(),
+          where + ".threads: must be from 0 (automatic) to " + std::to_string(max_thread_count()) +
+              " (4 x this machine's cores), got " + std::to_string(c.threads) + " (--threads)");
   require(c.save_every >= 1, where + ".save_every: must be at least 1");
   require(c.eval_rays_per_chunk >= 1, where + ".eval_rays_per_chunk: must be at least 1");
   check_schedule(c.fields, where + ".fields");

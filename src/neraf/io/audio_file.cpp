@@ -38,7 +38,13 @@ std::string lower_extension(const std::string& path) {
 // libsndfile opens a WAV/AIFF whose data chunk is cut short (an interrupted copy or recording)
 // and silently returns only the frames present; it only notes "data : <declared> (should be
 // <actual>)" in its log. A declared size larger than what is there means the file was truncated.
-// 0 and 0xFFFFFFFF-like sizes are placeholders of streamed recordings, not truncation.
+// 0 and the sizes writers put when they cannot seek back (0xFFFFFFFF and a few bytes less,
+// 0x7FFFFFFF, and 0x7FFFF000 of `espeak-ng --stdout` / SoX to a pipe) are placeholders of
+// streamed audio, not truncation.
+bool streamed_size_placeholder(long long declared) {
+  return declared >= 0xFFFFFF00LL || declared == 0x7FFFFFFFLL || declared == 0x7FFFF000LL;
+}
+
 bool data_chunk_truncated(SNDFILE* file, int64_t* declared, int64_t* actual) {
   std::string log(1 << 14, '\0');
   sf_command(file, SFC_GET_LOG_INFO, log.data(), static_cast<int>(log.size()));
@@ -49,7 +55,7 @@ bool data_chunk_truncated(SNDFILE* file, int64_t* declared, int64_t* actual) {
         log.substr(pos, eol == std::string::npos ? std::string::npos : eol - pos);
     long long d = 0, a = 0;
     if (std::sscanf(line.c_str(), "data : %lld (should be %lld)", &d, &a) == 2 && d > a && d > 0 &&
-        d < 0xFFFFFF00LL) {
+        !streamed_size_placeholder(d)) {
       *declared = d;
       *actual = a;
       return true;

@@ -11,6 +11,7 @@
 // overrides a preset); unknown keys and wrong types are neraf::Error naming "<where>: <key>".
 #include <nlohmann/json.hpp>
 
+#include <limits>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -107,7 +108,16 @@ void read_value(const nlohmann::json& j, T& value, const std::string& where) {
     require(j.is_boolean(), where + ": expected true or false");
     value = j.get<bool>();
   } else if constexpr (std::is_integral_v<T>) {
-    require(j.is_number_integer(), where + ": expected an integer");
+    using Limits = std::numeric_limits<T>;
+    const std::string range = "an integer from " + std::to_string(Limits::min()) + " to " +
+                              std::to_string(Limits::max()) + ", got " + j.dump();
+    require(j.is_number_integer(), where + ": expected " + range);
+    const bool fits = j.is_number_unsigned()
+                          ? j.get<uint64_t>() <= static_cast<uint64_t>(Limits::max())
+                          : j.get<int64_t>() >= static_cast<int64_t>(Limits::min()) &&
+                                (static_cast<uint64_t>(Limits::max()) > uint64_t{INT64_MAX} ||
+                                 j.get<int64_t>() <= static_cast<int64_t>(Limits::max()));
+    require(fits, where + ": expected " + range);
     value = j.get<T>();
   } else if constexpr (std::is_floating_point_v<T>) {
     require(j.is_number(), where + ": expected a number");

@@ -51,6 +51,12 @@ void check_out_dir(const std::string& dir, bool force) {
             dir +
                 ": the folder is not empty; choose a new or empty --out folder, or pass "
                 "--force to replace it");
+    // --force replaces a dataset synth wrote; it must not delete a run, real data or a home
+    // folder given by mistake.
+    require(empty || fs::exists(fs::path(dir) / "synth_info.json", ec),
+            dir +
+                ": is not a dataset written by neraf synth (no synth_info.json), so --force "
+                "does not replace it; choose a new or empty --out folder");
   }
 }
 
@@ -290,6 +296,22 @@ std::optional<double> synthesized_gain(const std::string& dataset_dir) {
   const double gain = io::read_json(path).value("gain", 0.0);
   require(gain > 0, path + ": no positive \"gain\"; synthesise that folder again");
   return gain;
+}
+
+std::optional<std::string> room_difference(const std::string& dataset_a,
+                                           const std::string& dataset_b) {
+  const fs::path a = fs::path(dataset_a) / "scene.json", b = fs::path(dataset_b) / "scene.json";
+  if (!fs::exists(a) || !fs::exists(b)) return std::nullopt;
+  json room_a = io::read_json(a.string()), room_b = io::read_json(b.string());
+  if (!room_a.is_object() || !room_b.is_object()) return std::nullopt;  // not ours to judge
+  for (json* room : {&room_a, &room_b})
+    for (const char* placement : {"name", "microphones", "sources", "cameras"})
+      room->erase(placement);
+  for (const auto& [key, value] : room_a.items())
+    if (room_b.value(key, json()) != value) return key;
+  for (const auto& [key, value] : room_b.items())
+    if (!room_a.contains(key)) return key;
+  return std::nullopt;
 }
 
 }  // namespace neraf::sim

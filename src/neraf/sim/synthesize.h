@@ -103,4 +103,10 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options);
 // without that file (e.g. a real dataset). neraf::Error when the file has no positive gain.
 std::optional<double> synthesized_gain(const std::string& dataset_dir);
 
+// Whether two `neraf synth` folders hold the same room: the first key of their scene.json that
+// differs, leaving out where the microphones, sources and cameras were put ("size", "furniture",
+// "materials", ...); none when the rooms match or a folder has no scene.json (e.g. real data).
+std::optional<std::string> room_difference(const std::string& dataset_a,
+                                           const std::string& dataset_b);
+
 }  // namespace neraf::sim
