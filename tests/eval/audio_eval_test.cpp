@@ -196,7 +196,8 @@ TEST(AudioEval, UncalibratedRowIsTheRunWithoutItsCalibration) {
 // An ablation may differ from the run it is compared with only in the ablation knobs.
 TEST(AudioEval, TrainingDifferenceAllowsOnlyTheAblationKnobs) {
   const TrainConfig main = tiny_joint_config();
-  const nlohmann::json main_data = {{"data", "runs/scene"}, {"audio", {{"hash", "abc"}}}};
+  const nlohmann::json main_data = {
+      {"data", "runs/scene"}, {"source", "runs/scene/transforms.json"}, {"audio", {{"hash", "abc"}}}};
   const nlohmann::json mj = infer::to_json(main);
   EXPECT_EQ(training_difference(mj, main_data, mj, main_data), "");
 
@@ -209,6 +210,7 @@ TEST(AudioEval, TrainingDifferenceAllowsOnlyTheAblationKnobs) {
   knobs.audio.cache_dir = "/elsewhere";
   nlohmann::json moved = main_data;
   moved["data"] = "/abs/runs/scene";  // the same dataset named another way
+  moved["source"] = "/abs/runs/scene/transforms.json";
   EXPECT_EQ(training_difference(mj, main_data, infer::to_json(knobs), moved), "");
 
   auto differs = [&](const TrainConfig& other, const std::string& key) {

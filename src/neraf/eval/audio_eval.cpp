@@ -415,7 +415,9 @@ std::string training_difference(const nlohmann::json& main_config, const nlohman
                                    "audio.cache_dir"};
   for (const std::string& k : ablation_knobs()) ignored.insert(k);
   std::string d = first_difference(main_config, other_config, ignored, "config.json");
-  if (d.empty()) d = first_difference(main_data, other_data, {"data"}, "data.json");
+  // "data" and "source" say where the dataset lay, as each training named it (relative or
+  // absolute); which data it is is in the file lists, pixel and audio hashes.
+  if (d.empty()) d = first_difference(main_data, other_data, {"data", "source"}, "data.json");
   return d;
 }
 
