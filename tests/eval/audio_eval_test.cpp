@@ -196,8 +196,9 @@ TEST(AudioEval, UncalibratedRowIsTheRunWithoutItsCalibration) {
 // An ablation may differ from the run it is compared with only in the ablation knobs.
 TEST(AudioEval, TrainingDifferenceAllowsOnlyTheAblationKnobs) {
   const TrainConfig main = tiny_joint_config();
-  const nlohmann::json main_data = {
-      {"data", "runs/scene"}, {"source", "runs/scene/transforms.json"}, {"audio", {{"hash", "abc"}}}};
+  const nlohmann::json main_data = {{"data", "runs/scene"},
+                                    {"source", "runs/scene/transforms.json"},
+                                    {"audio", {{"hash", "abc"}}}};
   const nlohmann::json mj = infer::to_json(main);
   EXPECT_EQ(training_difference(mj, main_data, mj, main_data), "");
 
