@@ -3,7 +3,7 @@
 set -euo pipefail
 PACKAGES=(
   build-essential cmake ninja-build pkg-config
-  libtorch-dev libopenblas0-openmp
+  libtorch-dev libgloo-dev libopenblas0-openmp
   libsndfile1-dev libsoxr-dev libmysofa-dev
   nlohmann-json3-dev libcli11-dev libstb-dev
   googletest libgtest-dev libbenchmark-dev

@@ -410,6 +410,96 @@ bad "--yaw" "$NERAF" auralize --rir "$WAV" --yaw 90 --in "$DRY" --out @OUT@.wav
 bad ".png" "$NERAF" render view --run "$BASE/run" --frame 0 --out @OUT@.jpg
 bad ".nrf" "$NERAF" export --run "$BASE/run" --out @OUT@.wav
 
+# --- fresh probe round b (docs/results/fresh_probes_2026-12-03b.md): each finding's class ------
+rm -rf "$BASE/ss/.neraf_cache"  # made by the runs above; a copy must not inherit it
+fresh tf_twice ss
+py "$D/transforms.json" <<'PY'
+import sys
+text = open(sys.argv[1]).read()
+open(sys.argv[1], "w").write(text.replace("{", '{"camera_model": "OPENCV", "camera_model": "OPENCV", ', 1))
+PY
+bad_data "appears twice"
+D=""
+# P01 outputs into the run's own dataset (or --data / --novel-data) are refused, the file intact.
+cp "$BASE/ss/transforms.json" "$TMP/transforms_before.json"
+bad "is inside" "$NERAF" eval --run "$BASE/run" --json "$BASE/ss/transforms.json" --skip-vision \
+  --no-baselines --quiet
+cmp -s "$TMP/transforms_before.json" "$BASE/ss/transforms.json" ||
+  fail "eval --json into the dataset changed transforms.json"
+bad "is inside" "$NERAF" render rir --run "$BASE/run" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 \
+  --out "$BASE/ss/$SSW/new.wav"
+[ -e "$BASE/ss/$SSW/new.wav" ] && fail "render rir wrote into the run's dataset"
+bad "is inside" "$NERAF" render loudness --run "$BASE/run" --src 1.1,1.2,0.9 --out @OUT@.png \
+  --csv "$BASE/ss/metadata.csv"
+bad "is inside" "$NERAF" eval --run "$BASE/run" --json @OUT@ --images "$BASE/run/checkpoints" \
+  --skip-vision --no-baselines --quiet
+# P02 a --max-len far beyond every training RIR (it padded 37 frames to 100000 for minutes).
+rm -rf "$BASE/ss/.neraf_cache"
+fresh max_len ss
+bad "--max-len 100000" "$NERAF" train --data "$D" --out @OUT@ --steps 1 --max-len 100000 \
+  --audio-start-step 0 --rays 64 --quiet
+D=""
+# P03/P24 --frames checked before anything is rendered.
+bad "--frames" "$NERAF" render trajectory --run "$BASE/run" --path "$TMP/path.json" --in "$DRY" \
+  --out @OUT@ --frames @OUT@
+# P04-P06, P26 outputs that name no file, empty values.
+bad "ends in '/'" "$NERAF" render rir --run "$BASE/run" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 \
+  --out @OUT@/
+bad "--out" "$NERAF" render rir --run "$BASE/run" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 --out ""
+bad "--checkpoint" "$NERAF" render rir --run "$BASE/run" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 \
+  --checkpoint "" --out @OUT@
+bad "--plan-only" "$NERAF" synth --preset demo --plan-only "" --quiet
+bad "standard output" "$NERAF" render rir --run "$BASE/run" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 \
+  --out -
+[ -e - ] && { rm -f -- -; fail "render rir --out - wrote a file named '-'"; }
+# P07 a key given twice in a pose list, a path, a transforms.json.
+echo '{"version": 1, "source": [1.1, 1.2, 0.9], "poses": [{"mic": [2, 1.5, 2.5], "mic": [2, 1.5, 2.4], "yaw": 0}]}' \
+  >"$TMP/twice_poses.json"
+bad "appears twice" "$NERAF" render rir --model "$BASE/model.nrf" --poses "$TMP/twice_poses.json" \
+  --out @OUT@
+# P08 a camera file with a misspelt or fractional size.
+python3 - "$BASE/run/data.json" "$TMP/cam_typo.json" "$TMP/cam_frac.json" <<'PY'
+import json, sys
+m = json.load(open(sys.argv[1]))
+c2w = m["eval_camera_to_world"][0]
+json.dump({"camera_to_world": c2w, "intrinsics": {"widht": 16}}, open(sys.argv[2], "w"))
+json.dump({"camera_to_world": c2w, "intrinsics": {"width": 16.5}}, open(sys.argv[3], "w"))
+PY
+bad "unknown key" "$NERAF" render view --run "$BASE/run" --pose "$TMP/cam_typo.json" --out @OUT@.png
+bad "whole numbers" "$NERAF" render view --run "$BASE/run" --pose "$TMP/cam_frac.json" \
+  --out @OUT@.png
+# P09-P11 flags that do not apply.
+bad ".png" "$NERAF" synth --preset demo --plan-only @OUT@.jpg
+bad "--hrtf" "$NERAF" synth --preset demo --layout raf --hrtf "$TMP/none.sofa" --out @OUT@ --quiet
+bad "--decay-loss" "$NERAF" train --data "$BASE/ss" --modality vision --decay-loss 5 --out @OUT@ \
+  --steps 2 --quiet
+bad "--grid-resolution" "$NERAF" train --data "$BASE/ss" --grid none --grid-resolution 64 \
+  --out @OUT@ --steps 2 --quiet
+# P12 the run's own dataset as "new positions".
+bad "own dataset" "$NERAF" eval --run "$BASE/run" --novel-data "$BASE/ss" --json @OUT@ \
+  --skip-vision --no-baselines --quiet
+# P13/P14 a damaged config.json / data.json value names the file.
+fresh run_chunk0 run; json_edit "$D/config.json" 'd["eval_rays_per_chunk"] = 0'
+bad "$D/config.json" "$NERAF" render view --run "$D" --frame 0 --out @OUT@.png
+fresh run_hop0 run; json_edit "$D/data.json" 'd["audio"]["hop_length"] = 0'
+bad "$D/data.json" "$NERAF" render rir --run "$D" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 --out @OUT@
+fresh run_nfft7 run; json_edit "$D/data.json" 'd["audio"]["n_fft"] = 7'
+bad "$D/data.json" "$NERAF" render rir --run "$D" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 --out @OUT@
+# P17 a checkpoint name that is a folder.
+fresh run_ckdir run; mkdir "$D/checkpoints/step-000099999.pt"
+bad "step-000099999.pt" "$NERAF" render rir --run "$D" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 \
+  --out @OUT@
+D=""
+# P15/P22 launch: a process count that cannot split the batches, train's flags without "--".
+bad "-n 3" "$NERAF" launch -n 3 -- train --data "$BASE/ss" --out @OUT@ --steps 1 --quiet
+bad "put --" "$NERAF" launch -n 2 train --data "$BASE/ss" --out @OUT@ --steps 1 --quiet
+# P19 a dry signal whose rate cannot be resampled names --in.
+float_wav "$TMP/dry_1hz.wav" 1 1 0.5
+bad "--in $TMP/dry_1hz.wav" "$NERAF" auralize --rir "$WAV" --in "$TMP/dry_1hz.wav" --out @OUT@.wav
+# P23 info takes the transforms.json form as train does.
+run "$NERAF" info --no-t60 "$BASE/ss/transforms.json"
+[ "$got" -eq 0 ] || fail "info DS/transforms.json exited $got: $(tail -c 300 "$TMP/err")"
+
 # A mistyped command or option gets a suggestion.
 run "$NERAF" trian --data x
 [ "$got" -eq 2 ] && grep -q "did you mean 'train'" "$TMP/err" ||

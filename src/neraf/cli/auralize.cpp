@@ -41,7 +41,11 @@ io::AudioBuffer load_dry(const std::string& path, int rate) {
   if (dry.sample_rate != rate) {
     info("note: resampling " + path + " from " + std::to_string(dry.sample_rate) + " Hz to " +
          std::to_string(rate) + " Hz to match the impulse response");
-    dry = dsp::resample(dry, rate);
+    try {
+      dry = dsp::resample(dry, rate);
+    } catch (const Error& e) {
+      throw Error("--in " + path + ": " + e.what());
+    }
   }
   return dry;
 }

@@ -38,8 +38,7 @@ void run_calibrate(const CalibrateArgs& args) {
   load.progress = !args.quiet;
   // The cache training used (recorded in its config), unless the flags say otherwise.
   const std::string config_path = args.run_dir + "/config.json";
-  const infer::TrainConfig cfg =
-      infer::train_config_from_json(io::read_json(config_path), config_path);
+  const infer::TrainConfig cfg = infer::read_run_config(config_path);
   load.cache_dir = args.cache_dir_opt->count() ? args.cache_dir : cfg.audio.cache_dir;
   load.half_precision = data::parse_cache_precision(
       args.cache_precision.empty() ? cfg.audio.cache_precision : args.cache_precision);

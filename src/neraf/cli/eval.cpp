@@ -20,6 +20,7 @@
 #include "neraf/data/layout.h"
 #include "neraf/eval/audio_eval.h"
 #include "neraf/eval/evaluation.h"
+#include "neraf/geometry/vec.h"
 #include "neraf/infer/audio_run.h"
 #include "neraf/infer/exported_model.h"
 #include "neraf/infer/run.h"
@@ -27,6 +28,7 @@
 #include "neraf/io/json_file.h"
 #include "neraf/sim/synthesize.h"
 #include "neraf/util/error.h"
+#include "neraf/util/log.h"
 
 namespace neraf::cli {
 
@@ -313,6 +315,19 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
     // Cut or padded to the run's frames, whatever the set's own automatic value would be.
     novel = load_rirs(args.novel_data, !args.quiet, cache, rirs.max_len);
     infer::check_same_room_format(source.manifest.at("audio"), *novel, args.novel_data);
+    // Positions within 1 mm of a training microphone's are not new positions.
+    int64_t seen = 0;
+    for (const data::Rir& r : novel->rirs)
+      for (int64_t i : subset)
+        if (geometry::norm(r.mic - rirs.rirs[static_cast<size_t>(i)].mic) < 1e-3) {
+          ++seen;
+          break;
+        }
+    if (seen > 0)
+      warn("--novel-data " + args.novel_data + ": " + std::to_string(seen) + " of " +
+           std::to_string(novel->size()) +
+           " RIRs are at microphone positions the run trained on; their scores are not of new "
+           "positions");
   }
   auto first_rirs = [&](std::vector<int64_t> rirs_to_score) {  // --max-rirs
     if (args.max_rirs >= 0 && static_cast<int64_t>(rirs_to_score.size()) > args.max_rirs)
@@ -515,7 +530,23 @@ void register_eval(CLI::App& app) {
   cmd->callback([args]() {
     if (args->threads > 0) torch::set_num_threads(args->threads);
     if (args->run.empty() && args->model.empty()) throw CLI::RequiredError("--run or --model");
-    require_safe_output({"--json", args->json}, {{"--model", args->model}}, args->run);
+    const std::vector<FlagPath> inputs = {
+        {"--model", args->model}, {"--data", args->data}, {"--novel-data", args->novel_data}};
+    require_safe_output({"--json", args->json}, inputs, args->run);
+    if (!args->novel_data.empty() && !args->run.empty()) {
+      std::vector<std::string> own = infer::run_input_folders(args->run);
+      if (!args->data.empty()) own.push_back(args->data);
+      for (const std::string& folder : own) {
+        std::error_code ec;
+        require(!std::filesystem::equivalent(folder, args->novel_data, ec),
+                "--novel-data " + args->novel_data +
+                    ": is the run's own dataset, whose RIRs it trained on; give a dataset of the "
+                    "same room at other microphone positions (neraf synth --mics random --seed N)");
+      }
+    }
+    std::vector<FlagPath> folder_inputs = inputs;
+    folder_inputs.push_back({"--json", args->json});
+    require_safe_output_folder({"--images", args->images}, folder_inputs, args->run);
     if (!args->model.empty()) {
       const infer::ExportedModel model = infer::load_exported_model(args->model);
       const nlohmann::json& meta = model.metadata();
@@ -556,8 +587,7 @@ void register_eval(CLI::App& app) {
     std::error_code ec;
     require(std::filesystem::is_regular_file(config_path, ec),
             args->run + ": not a training run (no config.json); check --run");
-    const infer::TrainConfig cfg =
-        infer::train_config_from_json(io::read_json(config_path), config_path);
+    const infer::TrainConfig cfg = infer::read_run_config(config_path);
     nlohmann::json out = {{"run", args->run}};
     const std::string shown =
         args->images.empty() ? (std::filesystem::path(args->run) / "eval").string() : args->images;
@@ -642,6 +672,11 @@ void register_eval(CLI::App& app) {
           if (!args->skip_vision) {
             // An audio-only run has no radiance field of its own: its --vision-run's is evaluated.
             const bool own = cfg.modality != infer::Modality::audio;
+            std::error_code ec;
+            require(own || std::filesystem::is_directory(cfg.audio.vision_run, ec),
+                    config_path + ": audio.vision_run " + cfg.audio.vision_run +
+                        " (whose radiance field the images are scored with) is gone; restore "
+                        "it, or pass --skip-vision to score the audio only");
             infer::LoadedRun run = infer::load_run(own ? args->run : cfg.audio.vision_run,
                                                    torch::kCPU, own ? args->checkpoint : "");
             if (!out.contains("checkpoint")) {

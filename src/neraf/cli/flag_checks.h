@@ -27,12 +27,18 @@ struct FlagPath {
   std::string flag, path;
 };
 
-// Before any work: neraf::Error unless the output `out` is a path that may be written (absent or
-// a regular file, io::require_replaceable_file), names none of `inputs` (nor another output), and
-// is no file of the run folder `run_dir` ("" for none): its config.json, data.json, lock or a
-// checkpoint. Outputs replacing their own inputs destroyed a user's recording, model or run.
+// Before any work: neraf::Error unless the output file `out` is a path that may be written (a
+// file name, not "-" or "dir/"; absent or a regular file, io::require_replaceable_file), names
+// none of `inputs` (nor another output), lies in no input folder, and is no file of the run
+// folder `run_dir` ("" for none): its config.json, data.json, lock, checkpoints, datasets or
+// vision runs (infer::run_input_folders). Outputs replacing their own inputs destroyed a user's
+// recording, model, dataset or run. An empty `out` (flag not given) passes.
 void require_safe_output(const FlagPath& out, const std::vector<FlagPath>& inputs,
                          const std::string& run_dir = "");
+// The same for an output folder (eval --images, render rir --poses --out, --frames): a folder or
+// nothing yet, holding none of the input files, inside none of the protected folders.
+void require_safe_output_folder(const FlagPath& out, const std::vector<FlagPath>& inputs,
+                                const std::string& run_dir = "");
 
 // Usage error unless `path` ends in `extension` (".png", ".nrf"), case-insensitively: an output
 // named for another format would hold bytes its name does not promise.

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -93,7 +94,16 @@ void run(const InfoArgs& args) {
       return out;
     };
   }
-  const data::DatasetReport report = data::inspect_dataset(args.dir, options);
+  // As train --data, the folder or its transforms.json.
+  std::error_code ec;
+  std::string dir = args.dir;
+  if (!std::filesystem::is_directory(dir, ec)) {
+    require(std::filesystem::path(dir).filename() == "transforms.json",
+            dir + ": is a file; give the dataset folder (or its transforms.json)");
+    dir = std::filesystem::path(dir).parent_path().string();
+    if (dir.empty()) dir = ".";
+  }
+  const data::DatasetReport report = data::inspect_dataset(dir, options);
 
   if (args.json) {
     std::printf("%s\n", report_json(report).dump(2).c_str());
@@ -132,9 +142,9 @@ void register_info(CLI::App& app) {
       "aabb, T60). Exits 1 if any error is found: no error means training accepts the data.");
   cmd->add_option("dir", args->dir,
                   "Dataset folder (a SoundSpaces scene, a RAF room, or a "
-                  "nerfstudio folder with transforms.json)")
+                  "nerfstudio folder with transforms.json), or its transforms.json")
       ->required()
-      ->check(CLI::ExistingDirectory);
+      ->check(CLI::ExistingPath);
   cmd->add_option("--max-problems", args->max_problems,
                   "Print at most this many problems (0 = all)")
       ->capture_default_str()

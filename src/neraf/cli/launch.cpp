@@ -28,6 +28,7 @@
 
 #include "neraf/cli/commands.h"
 #include "neraf/cli/flag_checks.h"
+#include "neraf/infer/train_config.h"
 #include "neraf/train/interrupt.h"
 #include "neraf/util/error.h"
 
@@ -108,6 +109,54 @@ pid_t spawn(const std::vector<std::string>& argv, int out_fd) {
   return pid;
 }
 
+// The value of `name` in a train command line ("--name V" or "--name=V"); "" when absent.
+std::string flag_value(const std::vector<std::string>& command, const std::string& name) {
+  for (size_t i = 0; i < command.size(); ++i) {
+    if (command[i] == name && i + 1 < command.size()) return command[i + 1];
+    if (command[i].rfind(name + "=", 0) == 0) return command[i].substr(name.size() + 1);
+  }
+  return "";
+}
+
+// Before any process starts: every rank trains an equal share of the global batches, so N must
+// divide the rays per batch and the acoustic batch of the config train will use. A command
+// train would refuse for another reason passes here (train then says why).
+void check_batches_split(const std::vector<std::string>& command, int n) {
+  infer::TrainConfig cfg;
+  try {
+    if (std::find(command.begin(), command.end(), "--resume") != command.end()) {
+      cfg = infer::read_run_config(flag_value(command, "--out") + "/config.json");
+    } else {
+      infer::TrainFlags flags;
+      const std::string preset = flag_value(command, "--preset"),
+                        rays = flag_value(command, "--rays");
+      const std::string modality = flag_value(command, "--modality");
+      if (!preset.empty()) flags.preset = preset;
+      if (!modality.empty()) flags.modality = infer::parse_modality(modality);
+      if (!rays.empty()) flags.rays = std::stoll(rays);
+      cfg = infer::resolve_train_config(flags);
+    }
+  } catch (const std::exception&) {
+    return;
+  }
+  auto splits = [](int64_t batch) {
+    std::string list;
+    for (int d = 1; d <= 64; ++d)
+      if (batch % d == 0) list += (list.empty() ? "" : ", ") + std::to_string(d);
+    return list;
+  };
+  const std::string N = std::to_string(n);
+  if (cfg.modality != infer::Modality::audio && cfg.rays_per_batch % n != 0)
+    throw Error("launch -n " + N + ": the batch of " + std::to_string(cfg.rays_per_batch) +
+                " rays (--rays) does not split evenly over " + N + " processes; use -n " +
+                splits(cfg.rays_per_batch) + ", or a --rays that " + N + " divides");
+  if (cfg.modality != infer::Modality::vision && cfg.audio.batch_size % n != 0)
+    throw Error("launch -n " + N + ": the acoustic batch of " +
+                std::to_string(cfg.audio.batch_size) + " slices (preset " + cfg.preset +
+                ") does not split evenly over " + N + " processes; use -n " +
+                splits(cfg.audio.batch_size));
+}
+
 int run_launch(const LaunchArgs& args) {
   require(!args.command.empty() && args.command[0] == "train",
           "launch: expected '-- train ...' after launch's own flags (e.g. neraf launch -n 2 -- "
@@ -117,6 +166,7 @@ int run_launch(const LaunchArgs& args) {
       require(a != own && a.rfind(std::string(own) + "=", 0) != 0,
               std::string("launch: ") + own +
                   " is set by launch for each process; remove it (use -n and --master-port)");
+  check_batches_split(args.command, args.nproc);
   const int port = args.master_port > 0 ? args.master_port : free_port();
   bool quiet_given = false;
   for (const auto& a : args.command) quiet_given |= a == "--quiet";
@@ -135,11 +185,15 @@ int run_launch(const LaunchArgs& args) {
     threads = std::max(1, cores / args.nproc);
     command.insert(command.end(), {"--threads", std::to_string(threads)});
   }
-  if (args.nproc * threads > cores)
+  if (args.nproc * threads > cores) {
+    const std::string advice = args.nproc > cores
+                                   ? "use -n " + std::to_string(cores) + " or fewer"
+                                   : "give each --threads " + std::to_string(cores / args.nproc);
     std::fprintf(stderr,
                  "warning: launch: %d processes x %d threads = %d threads on %d cores; the ranks "
-                 "will wait on each other (give each --threads %d)\n",
-                 args.nproc, threads, args.nproc * threads, cores, std::max(1, cores / args.nproc));
+                 "will wait on each other (%s)\n",
+                 args.nproc, threads, args.nproc * threads, cores, advice.c_str());
+  }
 
   train::InterruptGuard interrupt;  // Ctrl-C / SIGTERM → forwarded to the children
   std::vector<Child> children(static_cast<size_t>(args.nproc));
@@ -251,7 +305,13 @@ void register_launch(CLI::App& app) {
       ->check(real_number(0, 86400))
       ->capture_default_str();
   cmd->add_option("command", args->command, "After --: train and its flags")->required();
-  cmd->callback([args]() {
+  cmd->allow_extras();  // train's flags without "--" before them: said below, not a CLI11 list
+  cmd->callback([args, cmd]() {
+    if (cmd->remaining_size() > 0)  // the "--" mark itself is not counted
+      throw CLI::ValidationError(
+          "launch: put -- between launch's flags and the train command "
+          "(neraf launch -n 2 -- train --data DATA --out RUN); without it "
+          "train's flags are read as launch's");
     const int code = run_launch(*args);
     if (code != 0) throw ExitCode{code};
   });

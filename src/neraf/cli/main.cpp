@@ -86,6 +86,22 @@ std::string suggestion(const CLI::App& command, const std::vector<std::string>& 
   return "";
 }
 
+// An option given an empty value (`--out ""`, `--checkpoint=`) is a usage error everywhere:
+// taken as "not given" it made synth write a whole dataset for `--plan-only ""` and render use
+// the latest checkpoint for `--checkpoint ""`.
+void refuse_empty_values(CLI::App& command) {
+  const CLI::Validator non_empty(
+      [](std::string& text) {
+        return text.empty() ? std::string("empty value; give one, or leave the option out")
+                            : std::string();
+      },
+      "");
+  for (CLI::Option* option : command.get_options())
+    if (option->get_type_size_max() > 0) option->check(non_empty);
+  for (CLI::App* sub : command.get_subcommands([](CLI::App*) { return true; }))
+    refuse_empty_values(*sub);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -115,6 +131,7 @@ int main(int argc, char** argv) {
   neraf::cli::register_calibrate(app);
   neraf::cli::register_info(app);
   neraf::cli::register_synth(app);
+  refuse_empty_values(app);
 
   try {
     app.parse(argc, argv);

@@ -34,17 +34,20 @@ namespace fs = std::filesystem;
 namespace neraf::cli {
 namespace {
 
-std::string fmt3(const geometry::Vec3& p) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "(%.2f, %.2f, %.2f)", p.x, p.y, p.z);
+// Metres as a person reads them: 1.50, or 1e+300 (not 300 digits).
+std::string metres(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, std::abs(v) < 1e5 ? "%.2f" : "%.3g", v);
   return buf;
 }
 
+std::string fmt3(const geometry::Vec3& p) {
+  return "(" + metres(p.x) + ", " + metres(p.y) + ", " + metres(p.z) + ")";
+}
+
 std::string aabb_text(const data::Aabb& b) {
-  return "x " + std::to_string(b.min.x).substr(0, 6) + ".." + std::to_string(b.max.x).substr(0, 6) +
-         ", y " + std::to_string(b.min.y).substr(0, 6) + ".." +
-         std::to_string(b.max.y).substr(0, 6) + ", z " + std::to_string(b.min.z).substr(0, 6) +
-         ".." + std::to_string(b.max.z).substr(0, 6);
+  return "x " + metres(b.min.x) + ".." + metres(b.max.x) + ", y " + metres(b.min.y) + ".." +
+         metres(b.max.y) + ", z " + metres(b.min.z) + ".." + metres(b.max.z);
 }
 
 // A usage error (exit 2) naming the flag.
@@ -196,6 +199,10 @@ void add_render_rir(CLI::App& render) {
     }
     if (poses_opt->count() == 0)
       require_safe_output({"--out", args->out}, {{"--model", args->field.model}}, args->field.run);
+    else
+      require_safe_output_folder({"--out", args->out},
+                                 {{"--model", args->field.model}, {"--poses", args->poses}},
+                                 args->field.run);
     const LoadedField field = load_field(args->field);
     if (poses_opt->count() > 0) {
       render_pose_list(field, args->field, args->pose, args->poses, args->out);

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,7 @@
 #include "neraf/dsp/resample.h"
 #include "neraf/geometry/trajectory.h"
 #include "neraf/infer/run.h"
+#include "neraf/io/atomic_file.h"
 #include "neraf/io/audio_file.h"
 #include "neraf/io/json_file.h"
 #include "neraf/neraf_rt.h"
@@ -51,7 +53,11 @@ std::vector<float> mono_dry(const std::string& path, int rate) {
   if (dry.sample_rate != rate) {
     info("note: resampling " + path + " from " + std::to_string(dry.sample_rate) + " Hz to " +
          std::to_string(rate) + " Hz to match the field");
-    dry = dsp::resample(dry, rate);
+    try {
+      dry = dsp::resample(dry, rate);
+    } catch (const Error& e) {
+      throw Error("--in " + path + ": " + e.what());
+    }
   }
   if (dry.num_channels() > 1)
     info("note: " + path + " has " + std::to_string(dry.num_channels()) +
@@ -73,24 +79,28 @@ void check_stream(neraf_status status, const std::string& what) {
   if (status != NERAF_OK) throw Error(what + ": " + neraf_last_error());
 }
 
-// One PNG per video frame at `fps`: the radiance field seen from the listener, facing its heading.
-void render_frames(const FieldArgs& field_args, const geometry::Trajectory& path,
-                   const TrajectoryArgs& args, double duration_s) {
+// The radiance field --frames renders: the run's own, or an audio run's vision run.
+infer::LoadedRun load_view_run(const FieldArgs& field_args) {
   const std::string config = (fs::path(field_args.run) / "config.json").string();
-  const infer::TrainConfig cfg = infer::train_config_from_json(io::read_json(config), config);
+  const infer::TrainConfig cfg = infer::read_run_config(config);
   const bool own = cfg.modality != infer::Modality::audio;
   require(own || !cfg.audio.vision_run.empty(),
           field_args.run +
               ": has no radiance field for --frames (an audio-only run without "
               "--vision-run)");
-  infer::LoadedRun run = infer::load_run(own ? field_args.run : cfg.audio.vision_run, torch::kCPU,
-                                         own ? field_args.checkpoint : "");
-  const std::vector<geometry::TimedPose> poses =
-      geometry::sample_trajectory(path, args.fps, duration_s);
   std::error_code ec;
-  fs::create_directories(args.frames_dir, ec);
-  require(fs::is_directory(args.frames_dir, ec),
-          args.frames_dir + ": cannot create the --frames folder");
+  require(own || fs::is_directory(cfg.audio.vision_run, ec),
+          config + ": audio.vision_run " + cfg.audio.vision_run +
+              " (the radiance field --frames renders) is gone; restore it or drop --frames");
+  return infer::load_run(own ? field_args.run : cfg.audio.vision_run, torch::kCPU,
+                         own ? field_args.checkpoint : "");
+}
+
+// One PNG per video frame at `fps` into `dir`: the radiance field seen from the listener, facing
+// its heading.
+void render_frames(infer::LoadedRun& run, const geometry::Trajectory& path, double fps,
+                   double duration_s, const std::string& dir) {
+  const std::vector<geometry::TimedPose> poses = geometry::sample_trajectory(path, fps, duration_s);
   Progress progress("render frames", static_cast<int64_t>(poses.size()),
                     ProgressOptions{"frame", 0.2, 10.0, true});
   for (size_t i = 0; i < poses.size(); ++i) {
@@ -98,13 +108,11 @@ void render_frames(const FieldArgs& field_args, const geometry::Trajectory& path
         render::listener_camera_to_world(poses[i].mic, poses[i].yaw_deg), run.manifest);
     char name[32];
     std::snprintf(name, sizeof name, "frame_%05zu.png", i);
-    render::render_view(run, cam, (fs::path(args.frames_dir) / name).string(), "",
+    render::render_view(run, cam, (fs::path(dir) / name).string(), "",
                         run.config.eval_rays_per_chunk);
     progress.update(static_cast<int64_t>(i) + 1);
   }
   progress.finish();
-  std::printf("wrote %zu frames (%.3g fps) to %s\n", poses.size(), args.fps,
-              args.frames_dir.c_str());
 }
 
 void run_trajectory(const TrajectoryArgs& args) {
@@ -113,6 +121,9 @@ void run_trajectory(const TrajectoryArgs& args) {
           "the acoustic field");
   const geometry::Trajectory path = geometry::load_trajectory(args.path);
   const LoadedField field = load_field(args.field);
+  // Loaded before the audio is rendered, so a missing radiance field leaves nothing written.
+  std::optional<infer::LoadedRun> view_run;
+  if (!args.frames_dir.empty()) view_run = load_view_run(args.field);
   const infer::AudioRunInfo& info = field.field->info();
   const int sr = info.sample_rate;
   const std::vector<float> dry = mono_dry(args.dry, sr);
@@ -120,6 +131,14 @@ void run_trajectory(const TrajectoryArgs& args) {
   const size_t rir_length = static_cast<size_t>(info.stft.hop_length * (info.max_len - 1));
   const size_t out_length = dry.size() + rir_length - 1;
   const double duration_s = static_cast<double>(out_length) / sr;
+  if (path.keyframes.front().time >= duration_s) {
+    char msg[200];
+    std::snprintf(msg, sizeof msg,
+                  ": its first keyframe is at %.3f s, after the audio ends (%.3f s), so the whole "
+                  "render stays at that first pose",
+                  path.keyframes.front().time, duration_s);
+    warn(args.path + msg);
+  }
   // The poses of the updates; the path holds its last pose after its end.
   const std::vector<geometry::TimedPose> updates =
       geometry::sample_trajectory(path, args.rate_hz, duration_s);
@@ -189,6 +208,13 @@ void run_trajectory(const TrajectoryArgs& args) {
          ": peak above full scale; the float WAV keeps it, but playback will clip; "
          "pass --normalize");
   }
+  if (view_run) {
+    // The frames first: a failure there leaves neither the frames nor the WAV.
+    io::write_folder_atomically(args.frames_dir, [&](const std::string& tmp) {
+      render_frames(*view_run, path, args.fps, path.duration(), tmp);
+    });
+    std::printf("wrote %s: frames at %.3g fps\n", args.frames_dir.c_str(), args.fps);
+  }
   io::write_audio(args.out, result);
   std::printf(
       "wrote %s: %d ch, %d Hz, %.2f s; %lld RIRs from %s (step %lld) along %s (%.2f s, pose "
@@ -196,7 +222,6 @@ void run_trajectory(const TrajectoryArgs& args) {
       args.out.c_str(), result.num_channels(), sr, result.duration_s(),
       static_cast<long long>(rirs), field.name.c_str(), static_cast<long long>(field.step),
       args.path.c_str(), path.duration(), args.rate_hz, args.block);
-  if (!args.frames_dir.empty()) render_frames(args.field, path, args, path.duration());
 }
 
 }  // namespace
@@ -243,14 +268,17 @@ void add_render_trajectory(CLI::App& render) {
       ->capture_default_str();
   cmd->add_flag("--normalize", args->normalize, "Scale the result so its peak is 0.99");
   cmd->add_option("--frames", args->frames_dir,
-                  "Also render a view per video frame into this folder (needs --run with a "
-                  "radiance field)");
+                  "Also render a view per video frame (frame_00000.png, ...) into this new or "
+                  "empty folder (needs --run with a radiance field)");
   cmd->add_option("--fps", args->fps, "Video frames per second for --frames")
       ->check(real_number(0.01, 120))
       ->capture_default_str();
   cmd->callback([args] {
     require_safe_output({"--out", args->out}, {{"--in", args->dry}, {"--model", args->field.model}},
                         args->field.run);
+    require_safe_output_folder({"--frames", args->frames_dir},
+                               {{"--out", args->out}, {"--in", args->dry}, {"--path", args->path}},
+                               args->field.run);
     run_trajectory(*args);
   });
 }

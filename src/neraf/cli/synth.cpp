@@ -48,6 +48,9 @@ void run_synth(SynthArgs a) {
   const std::string where = a.preset.empty() ? a.scene_file : "preset " + a.preset;
   if (a.layout.empty()) a.layout = a.preset.empty() ? "soundspaces" : sim::preset_layout(a.preset);
   if (!a.preset.empty() || !a.mics.empty() || a.mic_count > 0) sim::validate_scene(scene, where);
+  require(a.hrtf.empty() || a.layout == "soundspaces",
+          "--hrtf: only the soundspaces layout is binaural; the " + a.layout +
+              " layout's RIRs are mono, so drop --hrtf (or use --layout soundspaces)");
   if (a.print_scene) {
     std::printf("%s\n", sim::scene_to_json(scene).dump(2).c_str());
     return;
@@ -55,6 +58,8 @@ void run_synth(SynthArgs a) {
   // Before the plan (a million microphones would already be gigabytes of jobs) and before --out.
   sim::check_synthesis_size(scene, a.layout, where, "--mics, --mic-count");
   if (!a.plan_only.empty()) {
+    require_safe_output({"--plan-only", a.plan_only}, {{"--scene", a.scene_file}});
+    require_extension({"--plan-only", a.plan_only}, ".png");
     const sim::SynthPlan plan = sim::plan_synthesis(scene, a.layout, a.seed);
     sim::write_plan_png(a.plan_only, sim::draw_plan(scene, plan));
     std::printf("wrote the plan of scene \"%s\" (%s layout, %zu RIRs) to %s\n", scene.name.c_str(),

@@ -318,6 +318,15 @@ void register_train(CLI::App& app) {
                 " --vision-run; a multi-scene run needs one --vision-run per --data, in the "
                 "same order");
 
+    if (flags.modality == infer::Modality::vision)
+      for (CLI::Option* o : {grid, args->grid_resolution_opt, fraction, audio_start, decay_loss,
+                             args->audio_loss_opt, no_relative, args->max_len_opt,
+                             args->cache_dir_opt, args->cache_precision_opt})
+        require(o->count() == 0, o->get_name() +
+                                     ": sets the acoustic field, which --modality vision does "
+                                     "not train; drop it (or train --modality joint)");
+    require(args->grid != "none" || args->grid_resolution_opt->count() == 0,
+            "--grid-resolution: --grid none has no grid; drop one of them");
     infer::TrainConfig cfg = infer::resolve_train_config(flags);
     cfg.audio.cache_dir = args->cache_dir;
     cfg.audio.cache_precision = args->cache_precision;

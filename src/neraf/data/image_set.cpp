@@ -16,6 +16,7 @@
 #include "neraf/io/json_file.h"
 #include "neraf/io/png.h"
 #include "neraf/util/error.h"
+#include "neraf/util/json_text.h"
 #include "neraf/util/log.h"
 #include "neraf/util/progress.h"
 
@@ -218,12 +219,7 @@ json read_json_lenient(const std::string& path) {
     }
     if (!replaced) out += c;
   }
-  try {
-    return json::parse(out);
-  } catch (const json::parse_error& e) {
-    throw Error(path + ": invalid JSON at byte " + std::to_string(e.byte) +
-                "; fix the file (it must be a nerfstudio transforms.json)");
-  }
+  return parse_json(out, path, "fix the file (it must be a nerfstudio transforms.json)");
 }
 
 struct Parsed {

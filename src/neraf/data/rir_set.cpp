@@ -263,6 +263,21 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
     for (int64_t i : set.train) train_frames[size_t(i)] = headers[size_t(i)].stft_frames;
     if (spec.max_len == 0) detail::check_padded_cache_size(set, train_frames, spec.half, problems);
     problems.throw_if_errors(set.root);
+    const int64_t longest = *std::max_element(train_frames.begin(), train_frames.end());
+    if (options.max_len > 0 && longest > 0 && options.max_len > 4 * longest) {
+      // Only silence is added, but every RIR costs max_len frames in the cache, in each training
+      // step and in the calibration: a typo (100000 for 100) costs hours.
+      char msg[320];
+      std::snprintf(msg, sizeof msg,
+                    "--max-len %lld: %.0fx the longest training RIR here (%lld STFT frames); it "
+                    "would pad every RIR with silence (a %.2f GB feature cache, training and "
+                    "calibration as much slower); use at most %lld or leave --max-len out",
+                    static_cast<long long>(options.max_len),
+                    double(options.max_len) / double(longest), static_cast<long long>(longest),
+                    detail::cache_bytes(set, options.max_len, spec.half) / 1e9,
+                    static_cast<long long>(4 * longest));
+      throw Error(set.root + ": " + msg);
+    }
     if (options.progress) problems.print_warnings();
     if (spec.max_len == 0)
       spec.max_len =

@@ -3,6 +3,7 @@
 #include <soxr.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "neraf/util/error.h"
@@ -12,14 +13,15 @@ namespace neraf::dsp {
 namespace {
 
 void check_rates(double from_hz, double to_hz) {
-  require(from_hz > 0.0 && to_hz > 0.0, "resample: sample rates must be positive (got " +
-                                            std::to_string(from_hz) + " Hz -> " +
-                                            std::to_string(to_hz) + " Hz)");
+  char rates[96];
+  std::snprintf(rates, sizeof rates, "%g Hz to %g Hz", from_hz, to_hz);
+  require(from_hz > 0.0 && to_hz > 0.0,
+          std::string("cannot resample ") + rates + ": sample rates must be positive");
   const double ratio = to_hz / from_hz;
   // A sane bound on the conversion ratio (soxr allows more; nothing here needs it).
   require(ratio >= 1.0 / 256.0 && ratio <= 256.0,
-          "resample: cannot convert " + std::to_string(from_hz) + " Hz to " +
-              std::to_string(to_hz) + " Hz (ratio beyond 1:256)");
+          std::string("cannot resample ") + rates +
+              " (the rates may be at most 256x apart); convert the audio to a usual rate first");
 }
 
 }  // namespace

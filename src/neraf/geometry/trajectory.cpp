@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "neraf/util/error.h"
+#include "neraf/util/json_text.h"
 
 namespace neraf::geometry {
 
@@ -285,14 +286,7 @@ json read_json_file(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   require(!in.bad(), path + ": read failed; check the file");
-  try {
-    return json::parse(text.str());
-  } catch (const json::parse_error& e) {
-    throw Error(path + ": not valid JSON (at byte " + std::to_string(e.byte) +
-                "); fix the file (docs/PATH_FORMAT.md)");
-  } catch (const json::exception& e) {  // e.g. a number too large for a double
-    throw Error(path + ": not valid JSON (" + e.what() + "); fix the file (docs/PATH_FORMAT.md)");
-  }
+  return parse_json(text.str(), path, "fix the file (docs/PATH_FORMAT.md)");
 }
 
 }  // namespace

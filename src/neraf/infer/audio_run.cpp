@@ -92,6 +92,32 @@ AudioRunInfo audio_info_from_manifest(const nlohmann::json& a, const std::string
     info.waveform_length = a.at("waveform_length").get<int64_t>();
     info.aabb.min = vec_from(a.at("aabb_min"));
     info.aabb.max = vec_from(a.at("aabb_max"));
+    // Every later failure (STFT sizes, a WAV at 0 Hz, a box inside out) would otherwise blame a
+    // flag or an output file.
+    auto check = [&](bool ok, const std::string& key, const nlohmann::json& value,
+                     const std::string& rule) {
+      require(ok, where + ": is damaged (audio." + key + " is " + value.dump() + "; " + rule +
+                      "); restore it or re-run neraf train");
+    };
+    const dsp::StftParams& s = info.stft;
+    check(info.sample_rate >= 1 && info.sample_rate <= 768000, "sample_rate", a["sample_rate"],
+          "expected 1..768000 Hz");
+    check(info.channels >= 1 && info.channels <= 64, "channels", a["channels"], "expected 1..64");
+    check(s.n_fft >= 2 && s.n_fft <= (1 << 20), "n_fft", a["n_fft"], "expected 2..1048576");
+    check(s.win_length >= 1 && s.win_length <= s.n_fft, "win_length", a["win_length"],
+          "expected 1..n_fft");
+    check(s.hop_length >= 1 && s.hop_length <= s.win_length, "hop_length", a["hop_length"],
+          "expected 1..win_length");
+    check(info.n_freq == s.n_fft / 2 + 1, "n_freq", a["n_freq"], "expected n_fft / 2 + 1");
+    check(info.max_len >= 2 && info.max_len <= 100000, "max_len", a["max_len"],
+          "expected 2..100000 frames");
+    check(info.waveform_length >= 1, "waveform_length", a["waveform_length"],
+          "expected a positive sample count");
+    const geometry::Vec3 &lo = info.aabb.min, &hi = info.aabb.max;
+    for (double v : {lo.x, lo.y, lo.z, hi.x, hi.y, hi.z})
+      check(std::isfinite(v), "aabb_min/aabb_max", a["aabb_min"], "expected finite metres");
+    check(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z, "aabb_min", a["aabb_min"],
+          "expected at most aabb_max " + a["aabb_max"].dump() + " on every axis");
     return info;
   } catch (const nlohmann::json::exception&) {
     throw Error(where + ": the audio manifest is incomplete; re-run neraf train");
@@ -197,7 +223,7 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
               "folder");
   AudioRun out;
   out.run_.run_dir = run_dir;
-  out.run_.config = train_config_from_json(io::read_json(config_path), config_path);
+  out.run_.config = read_run_config(config_path);
   require(out.run_.config.modality != Modality::vision,
           run_dir +
               ": this run has no acoustic field (trained with --modality vision); train "

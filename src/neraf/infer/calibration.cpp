@@ -14,7 +14,17 @@ namespace fs = std::filesystem;
 
 namespace neraf::infer {
 
-torch::Tensor fit_calibration(const AudioRun& run, const data::RirSet& rirs) {
+namespace {
+void stop_if_asked(const std::atomic<bool>* stop) {
+  if (stop && stop->load())
+    throw Interrupted(
+        "calibration stopped; nothing was written (neraf calibrate --run RUN "
+        "finishes it)");
+}
+}  // namespace
+
+torch::Tensor fit_calibration(const AudioRun& run, const data::RirSet& rirs,
+                              const std::atomic<bool>* stop) {
   const TrainConfig& config = run.run().config;
   const int64_t C = rirs.channels, F = rirs.n_freq, T = rirs.max_len;
   if (!config.audio.energy_calibration) return torch::ones({C, F, T});
@@ -28,6 +38,7 @@ torch::Tensor fit_calibration(const AudioRun& run, const data::RirSet& rirs) {
                 pred_energy = gt_energy.clone();
   std::vector<std::pair<int64_t, torch::Tensor>> preds;  // (RIR, [C, F, T]) for the balance
   for (int64_t k = 0; k < n; k += stride) {
+    stop_if_asked(stop);
     const int64_t i = train[static_cast<size_t>(k)];
     const torch::Tensor pred =
         run.predict_pose(rirs.mic_positions[i], rirs.source_positions[i], rirs.rots[i])
@@ -44,6 +55,7 @@ torch::Tensor fit_calibration(const AudioRun& run, const data::RirSet& rirs) {
   torch::Tensor delta = torch::zeros({C}, torch::kFloat64);
   std::vector<int64_t> counted(static_cast<size_t>(C), 0);
   for (size_t r = 0; r < preds.size(); ++r) {
+    stop_if_asked(stop);
     const auto& [i, pred] = preds[r];
     const torch::Tensor gt = rirs.waveform(i).contiguous();  // [C, L]
     const auto wave =
@@ -102,13 +114,13 @@ std::optional<torch::Tensor> load_calibration(const std::string& checkpoint, int
 }
 
 std::string calibrate_run(const std::string& run_dir, const data::RirSet& rirs,
-                          const std::string& checkpoint) {
-  return calibrate_run(run_dir, std::vector<const data::RirSet*>{&rirs}, checkpoint);
+                          const std::string& checkpoint, const std::atomic<bool>* stop) {
+  return calibrate_run(run_dir, std::vector<const data::RirSet*>{&rirs}, checkpoint, stop);
 }
 
 std::string calibrate_run(const std::string& run_dir,
                           const std::vector<const data::RirSet*>& scenes,
-                          const std::string& checkpoint) {
+                          const std::string& checkpoint, const std::atomic<bool>* stop) {
   std::vector<torch::Tensor> gains;
   std::string written, step_checkpoint;
   int64_t step = 0;
@@ -118,7 +130,7 @@ std::string calibrate_run(const std::string& run_dir,
         load_audio_run(run_dir, torch::kCPU, checkpoint, nerf::Precision::fp32,
                        /*calibrated=*/false, scenes.size() > 1 ? static_cast<int64_t>(s) : -1);
     check_audio_manifest(run.run().manifest["audio"], *scenes[s], run_dir + "/data.json");
-    gains.push_back(fit_calibration(run, *scenes[s]));
+    gains.push_back(fit_calibration(run, *scenes[s], stop));
     step_checkpoint = run.run().checkpoint;
     step = run.step();
   }

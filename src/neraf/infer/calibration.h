@@ -6,6 +6,7 @@
 // "step" and "gains"). Saving a checkpoint therefore stays fast and has no side effects.
 #include <torch/types.h>
 
+#include <atomic>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,8 +18,10 @@ namespace neraf::infer {
 
 // [C, F, T] gains fitted for `run` (loaded uncalibrated) on the run's training RIRs of `rirs`
 // (its few-shot subset; at most 512 evenly strided for the energies, 64 of those rendered
-// through Griffin-Lim for the balance); all ones when the run has calibration off.
-torch::Tensor fit_calibration(const AudioRun& run, const data::RirSet& rirs);
+// through Griffin-Lim for the balance); all ones when the run has calibration off. `stop` (set
+// asynchronously by Ctrl-C / SIGTERM) makes it throw neraf::Interrupted between two RIRs.
+torch::Tensor fit_calibration(const AudioRun& run, const data::RirSet& rirs,
+                              const std::atomic<bool>* stop = nullptr);
 
 // One file per checkpoint; a multi-scene run's holds every scene's gains ("gains", "gains_1", ...).
 void save_calibration(const std::string& checkpoint, int64_t step, const torch::Tensor& gains);
@@ -31,11 +34,13 @@ std::optional<torch::Tensor> load_calibration(const std::string& checkpoint, int
 
 // Fits and saves the calibration of RUN's latest checkpoint (or `checkpoint`) on `rirs` (the
 // run's dataset); returns the calibration file written. A multi-scene run: one RirSet per scene,
-// in the run's order.
+// in the run's order. Stopped by `stop`: neraf::Interrupted, nothing written.
 std::string calibrate_run(const std::string& run_dir, const data::RirSet& rirs,
-                          const std::string& checkpoint = "");
+                          const std::string& checkpoint = "",
+                          const std::atomic<bool>* stop = nullptr);
 std::string calibrate_run(const std::string& run_dir,
                           const std::vector<const data::RirSet*>& scenes,
-                          const std::string& checkpoint = "");
+                          const std::string& checkpoint = "",
+                          const std::atomic<bool>* stop = nullptr);
 
 }  // namespace neraf::infer

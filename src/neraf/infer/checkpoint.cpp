@@ -41,6 +41,7 @@ std::optional<std::string> latest_checkpoint(const std::string& run_dir) {
 
 std::string checkpoint_of_run(const std::string& run_dir, const std::string& checkpoint) {
   if (checkpoint.empty()) {
+    check_checkpoint_folder(run_dir);
     const auto latest = latest_checkpoint(run_dir);
     require(latest.has_value(),
             run_dir + ": no checkpoint yet; train first (neraf train --out " + run_dir + ")");
@@ -112,6 +113,20 @@ void load_archive_bytes(torch::serialize::InputArchive& archive, const std::stri
   } catch (const std::exception&) {
     throw Error(path + ": not a readable neraf checkpoint (truncated or corrupted)" + fix);
   }
+}
+
+void check_checkpoint_folder(const std::string& run_dir) {
+  const std::string dir = checkpoint_dir(run_dir);
+  std::error_code ec;
+  require(!fs::exists(dir, ec) || fs::is_directory(dir, ec),
+          dir +
+              ": is not a folder, so the run's checkpoints are gone; restore the folder or "
+              "train again in a new --out");
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    require(checkpoint_step_from_name(entry.path().string()) < 0 || entry.is_regular_file(ec),
+            entry.path().string() +
+                ": named as a checkpoint but not a regular file (a folder, or a link to one or "
+                "to a device); remove it or restore the checkpoint");
 }
 
 std::vector<std::string> checkpoints_newest_first(const std::string& run_dir) {

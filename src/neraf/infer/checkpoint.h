@@ -32,6 +32,10 @@ std::optional<std::string> latest_checkpoint(const std::string& run_dir);
 std::string checkpoint_of_run(const std::string& run_dir, const std::string& checkpoint);
 // Every checkpoint in RUN/checkpoints, highest step first.
 std::vector<std::string> checkpoints_newest_first(const std::string& run_dir);
+// neraf::Error when RUN/checkpoints is something else than a folder, or holds an entry named as
+// a checkpoint that is no regular file (a folder, a link to a device): such a run would read as
+// "no checkpoint yet" and train over it.
+void check_checkpoint_folder(const std::string& run_dir);
 // Deletes all but the `keep` newest checkpoints (and their calibrations); keep ≤ 0 keeps all.
 // Returns how many were deleted.
 int prune_checkpoints(const std::string& run_dir, int keep);

@@ -141,7 +141,7 @@ ExportReport export_model(const AudioRun& run, const std::string& path,
   try {
     rt::write_model_file(candidate, data);
   } catch (const std::exception& e) {
-    throw Error(e.what());
+    throw Error(io::with_user_path(e.what(), candidate, path));
   }
   std::error_code ec;
   struct RemoveCandidate {

@@ -40,8 +40,16 @@ data::Intrinsics intrinsics_from_json(const nlohmann::json& j, const std::string
   k.fy = num("fy", 0, true);
   k.cx = num("cx", 0, true);
   k.cy = num("cy", 0, true);
-  k.width = static_cast<int>(num("width", 0, true));
-  k.height = static_cast<int>(num("height", 0, true));
+  // Whole pixels, checked before the conversion (16.5 or 1e30 pixels is no image size).
+  auto pixels = [&](const char* key) {
+    const double v = num(key, 0, true);
+    require(v == std::floor(v) && v >= 1 && v <= 16384,
+            where + ": width and height must be whole numbers in 1..16384 (" + key + " is " +
+                j[key].dump() + ")");
+    return static_cast<int>(v);
+  };
+  k.width = pixels("width");
+  k.height = pixels("height");
   k.k1 = num("k1", 0, false);
   k.k2 = num("k2", 0, false);
   k.k3 = num("k3", 0, false);
@@ -232,6 +240,33 @@ std::vector<std::string> name_scenes(const std::vector<std::string>& data_dirs) 
   return names;
 }
 
+std::vector<std::string> run_input_folders(const std::string& run_dir) {
+  std::vector<std::string> folders;
+  auto read = [&](const char* name) {
+    try {
+      return io::read_json(run_file(run_dir, name));
+    } catch (const std::exception&) {
+      return nlohmann::json();
+    }
+  };
+  auto add = [&](const nlohmann::json& j, const char* key) {
+    if (j.is_object() && j.contains(key) && j[key].is_string())
+      folders.push_back(j[key].get<std::string>());
+  };
+  const nlohmann::json manifest = read("data.json");
+  add(manifest, "data");
+  if (is_multiscene(manifest))
+    for (const nlohmann::json& scene : manifest["scenes"]) add(scene, "data");
+  const nlohmann::json config = read("config.json");
+  if (config.is_object() && config.contains("audio")) {
+    add(config["audio"], "vision_run");
+    if (config["audio"].contains("vision_runs") && config["audio"]["vision_runs"].is_array())
+      for (const nlohmann::json& v : config["audio"]["vision_runs"])
+        if (v.is_string()) folders.push_back(v.get<std::string>());
+  }
+  return folders;
+}
+
 LoadedRun load_run(const std::string& run_dir, torch::Device device,
                    const std::string& checkpoint) {
   std::error_code ec;
@@ -244,7 +279,7 @@ LoadedRun load_run(const std::string& run_dir, torch::Device device,
               "folder");
   LoadedRun run;
   run.run_dir = run_dir;
-  run.config = train_config_from_json(io::read_json(config_path), config_path);
+  run.config = read_run_config(config_path);
   run.manifest = io::read_json(manifest_path);
   require(!is_multiscene(run.manifest),
           run_dir +

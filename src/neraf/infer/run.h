@@ -47,6 +47,12 @@ std::string scene_key(const std::string& key, int64_t scene);
 // Names for scenes from their dataset folders: the folder's name, unless two share it.
 std::vector<std::string> name_scenes(const std::vector<std::string>& data_dirs);
 
+// The folders a run was made from, which no command on the run may write into: its datasets
+// (RUN/data.json "data", each scene's) and the vision runs its acoustic field stands on
+// (config.json audio.vision_run / vision_runs). Best effort: a missing or damaged file adds
+// nothing (loading the run reports it).
+std::vector<std::string> run_input_folders(const std::string& run_dir);
+
 // A trained run, ready for rendering (model in eval mode on `device`).
 struct LoadedRun {
   std::string run_dir;

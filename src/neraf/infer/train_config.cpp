@@ -6,6 +6,7 @@
 
 #include "neraf/acoustic/acoustic_model.h"
 #include "neraf/acoustic/losses.h"
+#include "neraf/io/json_file.h"
 #include "neraf/nerf/config_io.h"
 #include "neraf/util/error.h"
 #include "neraf/util/number_text.h"
@@ -240,10 +241,19 @@ void validate(const TrainConfig& c, const std::string& where) {
                 "audio.vision_run (one --vision-run per --data)");
   }
   if (c.modality != Modality::vision)
-    require(a.start_step < c.steps, where + ".audio.start_step: audio starts after step " +
-                                        std::to_string(a.start_step) + " but the run has only " +
-                                        std::to_string(c.steps) + " steps; raise --steps");
+    require(a.start_step < c.steps,
+            where + ".audio.start_step: audio starts after step " + std::to_string(a.start_step) +
+                " (--audio-start-step) but the run has only " + std::to_string(c.steps) +
+                " steps; raise --steps or lower --audio-start-step");
   check_schedule(a.schedule, where + ".audio.schedule");
+}
+
+TrainConfig read_run_config(const std::string& config_path) {
+  TrainConfig c = train_config_from_json(io::read_json(config_path), config_path);
+  TrainConfig checked = c;
+  checked.threads = 0;
+  validate(checked, config_path);
+  return c;
 }
 
 }  // namespace neraf::infer

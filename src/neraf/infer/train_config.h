@@ -221,4 +221,9 @@ int64_t num_scenes(const TrainConfig& c);
 // Range checks (neraf::Error "<where>.<key>: ...").
 void validate(const TrainConfig& c, const std::string& where);
 
+// RUN/config.json of a finished run, as render, eval, export and calibrate use it: read, overlaid
+// on its preset and validated (a damaged value is an error naming the file, never a raw library
+// failure later). Its thread count is not checked: the run may come from a bigger machine.
+TrainConfig read_run_config(const std::string& config_path);
+
 }  // namespace neraf::infer

@@ -84,7 +84,8 @@ void require_creatable(const std::string& path) {
     // Room for the longest temporary name made from it (".NAME.old.tmp-PID").
     require(part.string().size() + 20 <= NAME_MAX,
             path + ": the name '" + part.string().substr(0, 40) + "...' is longer than the " +
-                std::to_string(NAME_MAX - 20) + " characters neraf can write; choose a shorter name");
+                std::to_string(NAME_MAX - 20) +
+                " characters neraf can write; choose a shorter name");
   }
   std::error_code ec;
   fs::path folder = parent_or_dot(target);
@@ -99,6 +100,15 @@ void require_creatable(const std::string& path) {
                        std::strerror(errno) + "); choose a writable output path");
   ::close(fd);
   ::unlink(probe.c_str());
+}
+
+std::string with_user_path(std::string message, const std::string& tmp, const std::string& path) {
+  for (size_t at; (at = message.find(tmp)) != std::string::npos;)
+    message.replace(at, tmp.size(), path);
+  if (message.find(std::strerror(ENOSPC)) != std::string::npos &&
+      message.find("free") == std::string::npos)
+    message += "; free disk space and retry";
+  return message;
 }
 
 void sync_path(const std::string& path) {
@@ -123,6 +133,12 @@ void write_atomically(const std::string& path,
   try {
     write(tmp);
     sync_path(tmp);
+  } catch (const Interrupted&) {
+    fs::remove(tmp, ec);
+    throw;
+  } catch (const std::runtime_error& e) {
+    fs::remove(tmp, ec);
+    throw Error(with_user_path(e.what(), tmp, path));
   } catch (...) {
     fs::remove(tmp, ec);
     throw;
@@ -184,6 +200,12 @@ void write_folder_atomically(const std::string& dir,
   try {
     write(tmp.string());
     sync_tree(tmp.string());
+  } catch (const Interrupted&) {
+    fs::remove_all(tmp, ec);
+    throw;
+  } catch (const std::runtime_error& e) {
+    fs::remove_all(tmp, ec);
+    throw Error(with_user_path(e.what(), tmp.string(), target.string()));
   } catch (...) {
     fs::remove_all(tmp, ec);
     throw;

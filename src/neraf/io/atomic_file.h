@@ -33,6 +33,10 @@ void write_folder_atomically(const std::string& dir,
                              const std::function<void(const std::string&)>& write,
                              FolderWrite mode = FolderWrite::create);
 
+// An error raised while writing the temporary `tmp`, told about the user's `path` instead (the
+// hidden temporary is gone by the time it is read), with advice when the disk is full.
+std::string with_user_path(std::string message, const std::string& tmp, const std::string& path);
+
 // neraf::Error unless `path` is absent or a regular file (what write_atomically may replace).
 void require_replaceable_file(const std::string& path);
 

@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 
@@ -80,6 +82,11 @@ SndHandle open_checked(const std::string& path, SF_INFO& info, uintmax_t& bytes,
   size_known = !ec;
   require(!size_known || bytes > 0,
           path + ": the file is empty (0 bytes); expected an audio file (WAV, FLAC, ...)");
+  // libsndfile reports an unreadable file as a format error.
+  if (std::FILE* probe = std::fopen(path.c_str(), "rb"))
+    std::fclose(probe);
+  else
+    throw Error(path + ": cannot open (" + std::strerror(errno) + "); check its permissions");
   info = SF_INFO{};
   SndHandle file(sf_open(path.c_str(), SFM_READ, &info));
   if (!file) {

@@ -6,6 +6,7 @@
 namespace neraf::io {
 
 nlohmann::json read_json(const std::string& path);
+
 void write_json_atomically(const std::string& path, const nlohmann::json& value, int indent = 2);
 
 }  // namespace neraf::io

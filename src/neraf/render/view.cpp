@@ -4,6 +4,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <set>
+#include <string>
 
 #include "neraf/infer/image_output.h"
 #include "neraf/io/json_file.h"
@@ -98,10 +100,25 @@ Camera read_camera_file(const std::string& path, const nlohmann::json& manifest)
     else
       throw Error(path + ": missing \"camera_to_world\" (a 4×4 or 3×4 camera-to-world matrix)");
   }
+  // A misspelt key would otherwise be ignored and the default camera rendered without a word.
+  auto known_keys = [&](const nlohmann::json& object, const std::set<std::string>& known,
+                        const std::string& what) {
+    for (auto it = object.begin(); it != object.end(); ++it) {
+      std::string list;
+      for (const std::string& key : known) list += (list.empty() ? "" : ", ") + key;
+      require(known.count(it.key()) > 0,
+              path + ": " + what + "unknown key \"" + it.key() + "\"; the known keys are " + list);
+    }
+  };
+  if (j.is_object()) known_keys(j, {"camera_to_world", "transform_matrix", "intrinsics"}, "");
   Camera cam = dataset_camera(matrix_from_json(m, path + ": camera_to_world"), manifest);
   if (j.is_object() && j.contains("intrinsics")) {
     nlohmann::json k = j["intrinsics"];
     require(k.is_object(), path + ": \"intrinsics\" must be an object");
+    known_keys(k,
+               {"fx", "fy", "cx", "cy", "width", "height", "k1", "k2", "k3", "p1", "p2", "fl_x",
+                "fl_y", "w", "h"},
+               "intrinsics: ");
     // Accept transforms.json spellings.
     for (auto [from, to] : {std::pair<const char*, const char*>{"fl_x", "fx"},
                             {"fl_y", "fy"},

@@ -55,11 +55,20 @@ std::optional<std::string> newest_intact_checkpoint(const std::string& run_dir) 
 // The calibration stage (infer/calibration.h) of a finished audio/joint run, unless done.
 void calibrate_if_needed(const TrainConfig& cfg, const std::string& run_dir,
                          const std::string& checkpoint, int64_t step,
-                         const std::vector<const data::RirSet*>& rirs) {
+                         const std::vector<const data::RirSet*>& rirs,
+                         const std::atomic<bool>* stop) {
   if (cfg.modality == Modality::vision || !cfg.audio.energy_calibration || rirs.empty()) return;
   if (infer::load_calibration(checkpoint, step)) return;
   const auto t0 = std::chrono::steady_clock::now();
-  const std::string path = infer::calibrate_run(run_dir, rirs, checkpoint);
+  std::string path;
+  try {
+    path = infer::calibrate_run(run_dir, rirs, checkpoint, stop);
+  } catch (const Interrupted&) {
+    throw Interrupted("training reached step " + std::to_string(step) +
+                      " with its checkpoint saved, but the calibration was stopped; finish it "
+                      "with: neraf calibrate --run " +
+                      run_dir);
+  }
   info("calibrated the acoustic field on its training RIRs in " +
        std::to_string(static_cast<int>(std::lround(
            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count()))) +
@@ -196,6 +205,7 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
       if (options.steps) infer::set_run_length(cfg, *options.steps);
       if (options.threads) cfg.threads = *options.threads;
       if (fs::is_regular_file(manifest_path, ec)) old_manifest = io::read_json(manifest_path);
+      infer::check_checkpoint_folder(options.run_dir);
       const bool any = !infer::checkpoints_newest_first(options.run_dir).empty();
       resume_from = newest_intact_checkpoint(options.run_dir);
       require(resume_from || !any,
@@ -349,11 +359,14 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
   if (summary.start_step >= cfg.steps) {
     if (lead)
       info(options.run_dir + ": already trained to step " + std::to_string(summary.start_step) +
-           "; pass --steps N to train further");
+           (options.steps ? "; --steps " + std::to_string(*options.steps) +
+                                " is not beyond it, pass a larger --steps to train further"
+                          : "; pass --steps N to train further"));
     if (resume_from) {
       summary.checkpoint = *resume_from;
       if (lead)
-        calibrate_if_needed(cfg, options.run_dir, *resume_from, summary.start_step, all_rirs);
+        calibrate_if_needed(cfg, options.run_dir, *resume_from, summary.start_step, all_rirs,
+                            options.stop);
     }
     return summary;
   }
@@ -452,7 +465,8 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
   if (dist) summary.comm = dist->stats();
   if (summary.interrupted) return summary;  // the caller says so (cli: exit 130)
   if (lead)
-    calibrate_if_needed(cfg, options.run_dir, summary.checkpoint, summary.end_step, all_rirs);
+    calibrate_if_needed(cfg, options.run_dir, summary.checkpoint, summary.end_step, all_rirs,
+                        options.stop);
   return summary;
 }
 

@@ -1,0 +1,13 @@
+#pragma once
+// Parsing JSON text strictly: errors name the file and say how to fix it.
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace neraf {
+
+// JSON `text` read from `path`: neraf::Error naming `path` for a parse error (with its byte
+// offset) or a key given twice in one object, followed by `fix` (what to do about it).
+nlohmann::json parse_json(const std::string& text, const std::string& path,
+                          const std::string& fix = "fix or regenerate the file");
+
+}  // namespace neraf
