@@ -54,7 +54,10 @@ TEST(ResolveTrainConfig, CpuRunLengthPerModality) {
   EXPECT_EQ(joint.proposal_networks.max_steps, 3000);
   EXPECT_EQ(joint.audio.schedule.max_steps, 3000);
   EXPECT_EQ(joint.audio.start_step, 1000);
-  EXPECT_EQ(joint.audio.schedule.warmup_steps, 1000);
+  // The acoustic field warms up when it starts (at full LR from its first step it could
+  // saturate and stop learning).
+  EXPECT_EQ(joint.audio.schedule.warmup_start, 1000);
+  EXPECT_EQ(joint.audio.schedule.warmup_steps, 100);
 
   // Vision alone: 2000 steps, the tied schedules follow; camera_opt has its own decay.
   const TrainConfig vision = resolve("cpu", Modality::vision);
@@ -68,6 +71,7 @@ TEST(ResolveTrainConfig, CpuRunLengthPerModality) {
   EXPECT_EQ(audio.steps, 1500);
   EXPECT_EQ(audio.audio.schedule.max_steps, 1500);
   EXPECT_EQ(audio.audio.start_step, -1);
+  EXPECT_EQ(audio.audio.schedule.warmup_start, 0);
   EXPECT_EQ(audio.audio.schedule.warmup_steps, 100);
 }
 
@@ -102,9 +106,11 @@ TEST(ResolveTrainConfig, AudioWarmupIsCappedAtHalfAShortRun) {
   // A long run keeps the full warm-up.
   f.steps = 5000;
   EXPECT_EQ(resolve("cpu", Modality::audio, f).audio.schedule.warmup_steps, 100);
-  // Joint runs are not capped (audio starts at step 1000, the warm-up ends there).
+  // Joint runs: capped at half of what follows the audio start (step 1000).
   f.steps = 1500;
-  EXPECT_EQ(resolve("cpu", Modality::joint, f).audio.schedule.warmup_steps, 1000);
+  EXPECT_EQ(resolve("cpu", Modality::joint, f).audio.schedule.warmup_steps, 100);
+  f.steps = 1100;
+  EXPECT_EQ(resolve("cpu", Modality::joint, f).audio.schedule.warmup_steps, 50);
 }
 
 TEST(ResolveTrainConfig, ExplicitFlagsWin) {
@@ -150,21 +156,28 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
   EXPECT_EQ(resolve("paper", Modality::joint).seed, 42u);
 }
 
-TEST(ResolveTrainConfig, AudioStartStepMovesAWarmupThatEndedThere) {
+TEST(ResolveTrainConfig, AudioStartStepMovesTheWarmup) {
   TrainFlags f;
   f.audio_start_step = 500;
   TrainConfig c = resolve("cpu", Modality::joint, f);
   EXPECT_EQ(c.audio.start_step, 500);
-  EXPECT_EQ(c.audio.schedule.warmup_steps, 500);  // the preset's warm-up ended at step 1000
+  EXPECT_EQ(c.audio.schedule.warmup_start, 500);  // the cpu warm-up begins at the audio start
+  EXPECT_EQ(c.audio.schedule.warmup_steps, 100);
   f.audio_start_step = -1;
   c = resolve("cpu", Modality::joint, f);
   EXPECT_EQ(c.audio.start_step, -1);
-  EXPECT_EQ(c.audio.schedule.warmup_steps, 0);
-  // A warm-up that did not end at the start (audio: start −1, warm-up 100) stays.
+  EXPECT_EQ(c.audio.schedule.warmup_start, 0);
+  EXPECT_EQ(c.audio.schedule.warmup_steps, 100);
   f.audio_start_step = 200;
   c = resolve("cpu", Modality::audio, f);
   EXPECT_EQ(c.audio.start_step, 200);
+  EXPECT_EQ(c.audio.schedule.warmup_start, 200);
   EXPECT_EQ(c.audio.schedule.warmup_steps, 100);
+  // The paper preset's warm-up (the reference's) runs from step 0 up to the audio start.
+  f.audio_start_step = 500;
+  c = resolve("paper", Modality::joint, f);
+  EXPECT_EQ(c.audio.schedule.warmup_start, 0);
+  EXPECT_EQ(c.audio.schedule.warmup_steps, 500);
 }
 
 TEST(ResolveTrainConfig, VisionRunOnlyWithAudioAndAbsolute) {

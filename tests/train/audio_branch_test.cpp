@@ -54,6 +54,42 @@ TEST(AudioBranch, JointStepReportsAudioLossesAndTouchesTheGrid) {
   EXPECT_GT(trainer->group_lr("audio_fields"), 0.0);
 }
 
+TEST(SaturationWatch, FiresAfterPatienceStepsInARow) {
+  SaturationWatch w;
+  w.patience = 3;
+  EXPECT_FALSE(w.saturated(0.95));
+  EXPECT_FALSE(w.saturated(0.95));
+  EXPECT_FALSE(w.saturated(0.5));  // the run is broken
+  EXPECT_FALSE(w.saturated(1.0));
+  EXPECT_FALSE(w.saturated(1.0));
+  EXPECT_TRUE(w.saturated(0.91));
+}
+
+TEST(AudioBranch, SaturatedOutputsStopTrainingWithAMessage) {
+  torch::manual_seed(0);
+  const std::string dir = make_temp_dir("saturated");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  const data::ImageSet images = make_image_set();
+  auto trainer = make_trainer(tiny_joint_config(), &images, torch::kCPU, &rirs);
+  auto* audio = dynamic_cast<AudioBranch*>(trainer->branch("audio"));
+  {  // every output at −output_scale, where tanh has no gradient
+    torch::NoGradGuard no_grad;
+    for (auto& p : audio->model()->field()->named_parameters())
+      if (p.key().rfind("STFT_linear", 0) == 0 && p.key().find("bias") != std::string::npos)
+        p.value().fill_(-1000.0);
+  }
+  const StepResult first = trainer->step();
+  EXPECT_NEAR(first.metrics.at("audio_saturated"), 1.0, 1e-12);
+  int64_t steps = 1;
+  try {
+    for (; steps < 100; ++steps) trainer->step();
+    FAIL() << "a saturated acoustic field trained on for 100 steps";
+  } catch (const DivergedError& e) {
+    EXPECT_NE(std::string(e.what()).find("saturated"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(steps, SaturationWatch{}.patience - 1);  // the step that made it `patience`
+}
+
 TEST(AudioBranch, BeforeStartStepOnlyTheGridMoves) {
   torch::manual_seed(0);
   const std::string dir = make_temp_dir("start");

@@ -37,6 +37,18 @@ TEST(LrSchedule, WarmupRamps) {
   EXPECT_NEAR(learning_rate(s, 502000), std::sqrt(1e-4 * 1e-8), 1e-15);
 }
 
+TEST(LrSchedule, WarmupFromALaterStart) {
+  ScheduleConfig s{2e-3, 1e-4, 3000, 100, 1e-8, "linear", 1e-15, 1000};
+  EXPECT_DOUBLE_EQ(learning_rate(s, 0), 1e-8);  // before the branch starts
+  EXPECT_DOUBLE_EQ(learning_rate(s, 1000), 1e-8);
+  EXPECT_NEAR(learning_rate(s, 1050), 1e-8 + (2e-3 - 1e-8) * 0.5, 1e-18);
+  EXPECT_NEAR(learning_rate(s, 1100), 2e-3, 1e-16);
+  // Then log-linear over the remaining 1900 steps, flat afterwards.
+  EXPECT_NEAR(learning_rate(s, 2050), std::sqrt(2e-3 * 1e-4), 1e-15);
+  EXPECT_NEAR(learning_rate(s, 3000), 1e-4, 1e-16);
+  EXPECT_NEAR(learning_rate(s, 5000), 1e-4, 1e-16);
+}
+
 TEST(LrSchedule, CpuPresetDecaysOverTheRun) {
   const TrainConfig c = train_preset("cpu");
   EXPECT_DOUBLE_EQ(learning_rate(c.fields, 0), c.fields.lr);

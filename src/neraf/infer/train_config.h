@@ -22,8 +22,11 @@ Modality parse_enum(Modality, const std::string& s, const std::string& where);
 Modality parse_modality(const std::string& s);
 
 // nerfstudio ExponentialDecayScheduler: optional warm-up from lr_pre_warmup (linear, or a sine
-// ramp when warmup_ramp = "sine"), then log-linear from lr to lr_final over
-// [warmup_steps, max_steps], flat afterwards. Adam with this eps (betas 0.9/0.999, no decay).
+// ramp when warmup_ramp = "sine") over [warmup_start, warmup_start + warmup_steps], then
+// log-linear from lr to lr_final until max_steps, flat afterwards. Adam with this eps (betas
+// 0.9/0.999, no decay). warmup_start lets a branch that starts late (the cpu preset's acoustic
+// field, from step 1000) warm up when it starts: at full LR from its first step, Adam drove its
+// tanh outputs into saturation, where they stop learning (one seed in three on the demo room).
 struct ScheduleConfig {
   double lr = 1e-2;
   double lr_final = 1e-4;
@@ -32,6 +35,7 @@ struct ScheduleConfig {
   double lr_pre_warmup = 1e-8;
   std::string warmup_ramp = "linear";  // "linear" | "sine"
   double eps = 1e-15;
+  int64_t warmup_start = 0;  // lr_pre_warmup before it
 
   template <class V>
   void visit(V& v) {
@@ -42,6 +46,7 @@ struct ScheduleConfig {
     v("lr_pre_warmup", lr_pre_warmup);
     v("warmup_ramp", warmup_ramp);
     v("eps", eps);
+    v("warmup_start", warmup_start);
   }
 };
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <tuple>
 
 #include "neraf/acoustic/calibration.h"
@@ -220,6 +221,27 @@ LossDict AudioBranch::losses(StepContext& ctx) {
                            rot.to(device_));
   } else {
     std::tie(pred, gt) = forward_scenes(pos, frame, Bl);
+  }
+  {
+    // Over the whole global batch, so every rank stops at the same step.
+    const torch::Tensor own = pred.slice(0, 0, Bl).detach();
+    const double edge = 0.999 * model_->options().nacf.output_scale;
+    torch::Tensor counts = torch::stack({(own.abs() >= edge).sum().to(torch::kFloat64),
+                                         torch::tensor(double(own.numel()), torch::kFloat64)});
+    if (ctx.dist) ctx.dist->sum(counts);
+    const double share = counts[0].item<double>() / std::max(1.0, counts[1].item<double>());
+    ctx.metrics["audio_saturated"] = share;
+    if (saturation_.saturated(share)) {
+      char msg[240];
+      std::snprintf(msg, sizeof msg,
+                    "step %lld: the acoustic field's outputs are saturated (%.1f %% of the batch "
+                    "at +-%g for %lld audio steps in a row); its tanh has no gradient there, so "
+                    "it has stopped learning",
+                    static_cast<long long>(ctx.step), 100.0 * share,
+                    model_->options().nacf.output_scale,
+                    static_cast<long long>(saturation_.patience));
+      throw DivergedError(msg);
+    }
   }
   acoustic::AudioLossOptions loss_options;
   loss_options.criterion = *acoustic::parse_audio_criterion(config_.audio.loss);  // validated

@@ -40,6 +40,20 @@
 
 namespace neraf::train {
 
+// Consecutive audio steps whose outputs sit (almost) all at ±output_scale. There the tanh has no
+// gradient: the field has stopped learning for good while its loss stays finite, which the
+// NaN/Inf guard cannot see (seen on the demo room when Adam started at full LR).
+struct SaturationWatch {
+  int64_t patience = 50;   // steps in a row
+  double threshold = 0.9;  // share of saturated outputs in the batch
+  int64_t run = 0;
+  // The step's share of saturated outputs → true once `patience` steps in a row exceed it.
+  bool saturated(double share) {
+    run = share > threshold ? run + 1 : 0;
+    return run >= patience;
+  }
+};
+
 class AudioBranch : public Branch {
  public:
   // `field`: the radiance field that fills the grid (the vision branch's model in joint mode, or a
@@ -102,6 +116,7 @@ class AudioBranch : public Branch {
   torch::Tensor perm_;   // [n_train·max_len] int64: this epoch's slice order
   int64_t cursor_ = 0;   // next position in perm_
   torch::Tensor batch_;  // [B + D·T, C, F] float32 gather buffer
+  SaturationWatch saturation_;
 };
 
 }  // namespace neraf::train

@@ -6,14 +6,15 @@
 namespace neraf::train {
 
 double learning_rate(const infer::ScheduleConfig& s, int64_t step) {
-  if (step < s.warmup_steps) {
-    const double x = static_cast<double>(step) / static_cast<double>(s.warmup_steps);
+  const int64_t warm_end = s.warmup_start + s.warmup_steps;
+  if (step < warm_end) {
+    const double x = static_cast<double>(std::max<int64_t>(0, step - s.warmup_start)) /
+                     static_cast<double>(s.warmup_steps);
     const double r = s.warmup_ramp == "sine" ? std::sin(0.5 * M_PI * x) : x;
     return s.lr_pre_warmup + (s.lr - s.lr_pre_warmup) * r;
   }
-  const double t = std::clamp(static_cast<double>(step - s.warmup_steps) /
-                                  static_cast<double>(s.max_steps - s.warmup_steps),
-                              0.0, 1.0);
+  const double t = std::clamp(
+      static_cast<double>(step - warm_end) / static_cast<double>(s.max_steps - warm_end), 0.0, 1.0);
   return std::exp(std::log(s.lr) * (1.0 - t) + std::log(s.lr_final) * t);
 }
 

@@ -7,10 +7,11 @@
 
 namespace neraf::train {
 
-//   step < warmup: lr_pre_warmup + (lr − lr_pre_warmup)·r, r = step/warmup (linear) or
-//                  sin(π/2 · step/warmup) (sine)
-//   else:          exp(ln lr·(1 − s) + ln lr_final·s), s = clip((step − warmup)/(max − warmup), 0,
-//   1)
+//   step < start + warmup: lr_pre_warmup + (lr − lr_pre_warmup)·r, x = max(0, step − start)/warmup,
+//                          r = x (linear) or sin(π/2 · x) (sine)
+//   else:                  exp(ln lr·(1 − s) + ln lr_final·s),
+//                          s = clip((step − start − warmup)/(max − start − warmup), 0, 1)
+// (start = warmup_start, warmup = warmup_steps, max = max_steps)
 double learning_rate(const infer::ScheduleConfig& schedule, int64_t step);
 
 }  // namespace neraf::train
