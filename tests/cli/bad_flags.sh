@@ -147,7 +147,9 @@ bad --out "$NERAF" train --data "$FIX"
 bad --json "$NERAF" eval --run "$FIX"
 bad --in "$NERAF" auralize --rir "$WAV" --out "$WORK/a.wav"
 bad "--resume and --force" "$NERAF" train --out "$WORK/run" --resume --force
-bad --cache-dir "$NERAF" train --out "$WORK/run" --resume --cache-dir "$WORK/cache"
+mkdir -p "$TMP/resumable" && echo "{}" >"$TMP/resumable/config.json"  # flags are checked first
+bad --cache-dir "$NERAF" train --out "$TMP/resumable" --resume --cache-dir "$WORK/cache"
+bad "no run to resume" "$NERAF" train --out "$WORK/none" --resume --rays 128
 bad --model "$NERAF" eval --run "$FIX" --model "$FIX/m.nrf" --json "$WORK/e.json"
 bad --pred "$NERAF" metrics --rir "$WAV" --pred "$WAV" --gt "$WAV"
 bad --scene "$NERAF" synth --preset demo --scene "$FIX/order.json" --out "$WORK/ds"

@@ -28,7 +28,7 @@ quiet "$NERAF" synth --preset demo --layout raf --mics random --mic-count 2 --se
   --out "$BASE/raf" --quiet
 quiet "$NERAF" synth --preset shoebox --layout soundspaces --mics random --mic-count 2 --seed 5 \
   --out "$BASE/other_room" --quiet
-quiet "$NERAF" train --data "$BASE/ss" --out "$BASE/run" --steps 2 --audio-start-step 1 \
+quiet "$NERAF" train --data "$BASE/ss" --out "$BASE/run" --steps 2 --audio-start-step 0 \
   --rays 128 --quiet
 quiet "$NERAF" export --run "$BASE/run" --out "$BASE/model.nrf"
 # The dataset copies below must not inherit the run's feature cache.
@@ -132,7 +132,7 @@ bad_data() {
   next_out
   run "$NERAF" info --no-t60 "$D"
   check "info ${D#"$TMP/"} ($name)" "$name" info
-  run "$NERAF" train --data "$D" --out "$O" --steps 2 --audio-start-step 1 --rays 64 --quiet
+  run "$NERAF" train --data "$D" --out "$O" --steps 2 --audio-start-step 0 --rays 64 --quiet
   check "train on ${D#"$TMP/"} ($name)" "$name" cmd
 }
 
@@ -277,7 +277,7 @@ bad "training pictures" "$NERAF" train --data "$D" --modality audio --vision-run
   --steps 2 --out @OUT@ --quiet
 D=""
 fresh run_noconfig run; rm "$D/config.json"
-bad "$D" "$NERAF" eval --run "$D" --json @OUT@ --quiet
+bad "$D" "$NERAF" eval --run "$D" --json @OUT@.json --quiet
 fresh run_badconfig run; echo '{"preset": ' >"$D/config.json"
 bad "$D/config.json" "$NERAF" render view --run "$D" --frame 0 --out @OUT@.png
 fresh run_confdir run; rm "$D/config.json"; mkdir "$D/config.json"
@@ -285,7 +285,7 @@ bad "$D" "$NERAF" export --run "$D" --out @OUT@.nrf
 fresh run_nodata run; rm "$D/data.json"
 bad "$D/data.json" "$NERAF" render view --run "$D" --frame 0 --out @OUT@.png
 fresh run_baddata run; echo '[1, 2' >"$D/data.json"
-bad "$D/data.json" "$NERAF" eval --run "$D" --json @OUT@ --quiet
+bad "$D/data.json" "$NERAF" eval --run "$D" --json @OUT@.json --quiet
 CK=$(ls "$BASE/run/checkpoints/"step-*.pt | grep -v calibration | tail -n 1)
 CK=${CK#"$BASE/run/"}
 fresh run_cut_ckpt run; for f in "$D"/checkpoints/step-*.pt; do cut_half "$f"; done
@@ -297,7 +297,7 @@ cp "$BASE/model.nrf" "$TMP/half.nrf"; cut_half "$TMP/half.nrf"
 bad "$TMP/half.nrf" "$NERAF" render rir --model "$TMP/half.nrf" --mic 2,1.5,2.5 --src 1.1,1.2,0.9 \
   --out @OUT@
 echo "not a model" >"$TMP/foreign.nrf"
-bad "$TMP/foreign.nrf" "$NERAF" eval --model "$TMP/foreign.nrf" --data "$BASE/ss" --json @OUT@ \
+bad "$TMP/foreign.nrf" "$NERAF" eval --model "$TMP/foreign.nrf" --data "$BASE/ss" --json @OUT@.json \
   --quiet
 
 # --- audio given to metrics / auralize (WAV, FLAC) -------------------------------------------
@@ -331,8 +331,8 @@ bad "$TMP/empty_poses.json" "$NERAF" render rir --model "$BASE/model.nrf" \
   --poses "$TMP/empty_poses.json" --out @OUT@
 
 # --- a file where a folder is expected, and the reverse -------------------------------------
-bad "$WAV" "$NERAF" train --data "$WAV" --out @OUT@ --steps 2 --audio-start-step 1 --quiet
-bad "$WAV" "$NERAF" eval --run "$WAV" --json @OUT@ --quiet
+bad "$WAV" "$NERAF" train --data "$WAV" --out @OUT@ --steps 2 --audio-start-step 0 --quiet
+bad "$WAV" "$NERAF" eval --run "$WAV" --json @OUT@.json --quiet
 bad "$ASSETS" "$NERAF" metrics --rir "$ASSETS"
 
 # --- an output that is one of the command's inputs or a file of the run it reads -------------
@@ -352,10 +352,10 @@ cmp -s "$BASE/model.nrf" "$TMP/own_model.nrf" || fail "render loudness --out = -
 bad "--in" "$NERAF" render trajectory --model "$BASE/model.nrf" \
   --path "$ASSETS/../examples/paths/demo_walk.json" --in "$TMP/own_dry.wav" --out "$TMP/own_dry.wav"
 bad "not .mp3" "$NERAF" auralize --rir "$WAV" --in "$DRY" --out @OUT@.mp3
-bad "--ablation-runs" "$NERAF" eval --run "$BASE/run" --json @OUT@ --skip-vision \
+bad "--ablation-runs" "$NERAF" eval --run "$BASE/run" --json @OUT@.json --skip-vision \
   --ablation-runs "$BASE/run,$BASE/run"
 # An exported model records no training config, so no ablation can be checked against it.
-bad "needs --run" "$NERAF" eval --model "$BASE/model.nrf" --json @OUT@ --ablation-runs "$BASE/run"
+bad "needs --run" "$NERAF" eval --model "$BASE/model.nrf" --json @OUT@.json --ablation-runs "$BASE/run"
 # A checkpoint copied in under another step's name, a gain from a set of the other layout, a
 # JSON key given twice.
 last=$(ls "$BASE"/run/checkpoints/step-*[0-9].pt | tail -1)
@@ -370,7 +370,7 @@ bad "appears twice" "$NERAF" synth --scene "$TMP/twice.json" --out @OUT@ --quiet
 # --force restarts a run, never turns another folder into one; outputs that cannot be written
 # fail before the work (a name too long, /proc, a deleted working folder).
 bad "not a neraf run folder" "$NERAF" train --data "$BASE/ss" --out "$BASE/ss/images" --force \
-  --steps 2 --audio-start-step 1 --quiet
+  --steps 2 --audio-start-step 0 --quiet
 [ -e "$BASE/ss/images/config.json" ] && fail "train --force wrote into a dataset's images folder"
 # ... and synth --force replaces only a dataset synth wrote, never a run.
 bad "not a dataset written by neraf synth" "$NERAF" synth --preset demo --layout raf \
@@ -392,7 +392,7 @@ cp -r "$BASE/run" "$TMP/other_run"
 OTHER_CK=$(ls "$TMP"/other_run/checkpoints/step-*[0-9].pt | tail -n 1)
 bad "not a checkpoint of the run" "$NERAF" calibrate --run "$BASE/run" --checkpoint "$OTHER_CK"
 bad "not a checkpoint of the run" "$NERAF" eval --run "$BASE/run" --checkpoint "$OTHER_CK" \
-  --json @OUT@ --skip-vision --no-baselines --quiet
+  --json @OUT@.json --skip-vision --no-baselines --quiet
 bad "not a checkpoint of the run" "$NERAF" export --run "$BASE/run" --checkpoint "$OTHER_CK" \
   --out @OUT@.nrf
 bad "not a checkpoint of the run" "$NERAF" render view --run "$BASE/run" --checkpoint "$OTHER_CK" \
@@ -401,11 +401,11 @@ bad "not a checkpoint of the run" "$NERAF" render view --run "$BASE/run" --check
 # a pose for a --rir file, outputs named for another format.
 bad "given twice" "$NERAF" train --modality audio --data "$BASE/ss" --data "$BASE/ss/" \
   --vision-run "$BASE/run" --vision-run "$BASE/run" --out @OUT@ --steps 2 --quiet
-bad "is --run itself" "$NERAF" eval --run "$BASE/run" --ablation-runs "$BASE/run" --json @OUT@ \
+bad "is --run itself" "$NERAF" eval --run "$BASE/run" --ablation-runs "$BASE/run" --json @OUT@.json \
   --skip-vision --no-baselines --quiet
 quiet "$NERAF" train --data "$BASE/ss" --modality vision --out "$TMP/vision_only" --steps 2 \
   --rays 128 --quiet
-bad "nothing to evaluate" "$NERAF" eval --run "$TMP/vision_only" --json @OUT@ --skip-vision --quiet
+bad "nothing to evaluate" "$NERAF" eval --run "$TMP/vision_only" --json @OUT@.json --skip-vision --quiet
 bad "--yaw" "$NERAF" auralize --rir "$WAV" --yaw 90 --in "$DRY" --out @OUT@.wav
 bad ".png" "$NERAF" render view --run "$BASE/run" --frame 0 --out @OUT@.jpg
 bad ".nrf" "$NERAF" export --run "$BASE/run" --out @OUT@.wav
@@ -431,12 +431,12 @@ bad "is inside" "$NERAF" render rir --run "$BASE/run" --mic 2.0,1.5,2.5 --src 1.
 [ -e "$BASE/ss/$SSW/new.wav" ] && fail "render rir wrote into the run's dataset"
 bad "is inside" "$NERAF" render loudness --run "$BASE/run" --src 1.1,1.2,0.9 --out @OUT@.png \
   --csv "$BASE/ss/metadata.csv"
-bad "is inside" "$NERAF" eval --run "$BASE/run" --json @OUT@ --images "$BASE/run/checkpoints" \
+bad "is inside" "$NERAF" eval --run "$BASE/run" --json @OUT@.json --images "$BASE/run/checkpoints" \
   --skip-vision --no-baselines --quiet
 # P02 a --max-len far beyond every training RIR (it padded 37 frames to 100000 for minutes).
 rm -rf "$BASE/ss/.neraf_cache"
 fresh max_len ss
-bad "--max-len 100000" "$NERAF" train --data "$D" --out @OUT@ --steps 1 --max-len 100000 \
+bad "--max-len 100000" "$NERAF" train --data "$D" --out @OUT@ --steps 2 --max-len 100000 \
   --audio-start-step 0 --rays 64 --quiet
 D=""
 # P03/P24 --frames checked before anything is rendered.
@@ -476,7 +476,7 @@ bad "--decay-loss" "$NERAF" train --data "$BASE/ss" --modality vision --decay-lo
 bad "--grid-resolution" "$NERAF" train --data "$BASE/ss" --grid none --grid-resolution 64 \
   --out @OUT@ --steps 2 --quiet
 # P12 the run's own dataset as "new positions".
-bad "own dataset" "$NERAF" eval --run "$BASE/run" --novel-data "$BASE/ss" --json @OUT@ \
+bad "own dataset" "$NERAF" eval --run "$BASE/run" --novel-data "$BASE/ss" --json @OUT@.json \
   --skip-vision --no-baselines --quiet
 # P13/P14 a damaged config.json / data.json value names the file.
 fresh run_chunk0 run; json_edit "$D/config.json" 'd["eval_rays_per_chunk"] = 0'

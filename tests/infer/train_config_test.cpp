@@ -278,6 +278,18 @@ TEST(TrainConfig, ReferencePresetIsThePublishedModel) {
   EXPECT_NO_THROW(validate(joint, "config.json"));
 }
 
+// Steps are numbered 0..steps−1 and audio runs after start_step: start = steps − 1 trains no
+// acoustic field at all (it used to pass, and be calibrated and exported untrained).
+TEST(TrainConfig, AtLeastOneAudioStep) {
+  TrainConfig c = train_preset("cpu");
+  c.modality = Modality::joint;
+  c.steps = 2;
+  c.audio.start_step = 1;
+  EXPECT_THROW(validate(c, "config.json"), Error);
+  c.audio.start_step = 0;
+  EXPECT_NO_THROW(validate(c, "config.json"));
+}
+
 TEST(TrainConfig, GridResolutionMustPassTheSceneEncoder) {
   TrainConfig c = train_preset("cpu");
   c.modality = Modality::joint;

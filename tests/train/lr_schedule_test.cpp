@@ -47,6 +47,11 @@ TEST(LrSchedule, WarmupFromALaterStart) {
   EXPECT_NEAR(learning_rate(s, 2050), std::sqrt(2e-3 * 1e-4), 1e-15);
   EXPECT_NEAR(learning_rate(s, 3000), 1e-4, 1e-16);
   EXPECT_NEAR(learning_rate(s, 5000), 1e-4, 1e-16);
+  // No warm-up at all (a short run's is capped to 0): the pre-warm-up LR up to the start, never
+  // 0 / 0 (a NaN LR reached the radiance field through the audio group).
+  s.warmup_steps = 0;
+  EXPECT_DOUBLE_EQ(learning_rate(s, 999), 1e-8);
+  EXPECT_NEAR(learning_rate(s, 1000), 2e-3, 1e-16);
 }
 
 TEST(LrSchedule, CpuPresetDecaysOverTheRun) {

@@ -44,7 +44,8 @@ io::AudioBuffer load_dry(const std::string& path, int rate) {
     try {
       dry = dsp::resample(dry, rate);
     } catch (const Error& e) {
-      throw Error("--in " + path + ": " + e.what());
+      throw Error("--in " + path + " (resampled to the impulse response's " + std::to_string(rate) +
+                  " Hz): " + e.what());
     }
   }
   return dry;

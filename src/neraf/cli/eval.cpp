@@ -252,13 +252,26 @@ void check_trained_alike(const infer::AudioRun& main, const std::string& main_di
               (main_calibrated ? dir : main_dir));
 }
 
+// --data, else the dataset the run (or the model) records, which must still be there.
+std::string dataset_of(const nlohmann::json& manifest, const EvalArgs& args) {
+  if (!args.data.empty()) return args.data;
+  require(manifest.contains("data") && manifest["data"].is_string(),
+          "the run's data.json records no dataset path (\"data\"); pass --data DIR");
+  const std::string dir = manifest["data"].get<std::string>();
+  std::error_code ec;
+  require(std::filesystem::is_directory(dir, ec),
+          dir +
+              ": the dataset recorded in the run's data.json (or the model) is gone; restore it, "
+              "or pass --data DIR holding the same data");
+  return dir;
+}
+
 // The acoustic field on the test RIRs (and, with --novel-data, on every RIR of another dataset of
 // the same room), with the nearest/linear baselines and the ablation runs.
 nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args,
                                    const OutputDir& dir) {
   const infer::AudioField& run = source.field;
-  const std::string data_dir =
-      args.data.empty() ? source.manifest.at("data").get<std::string>() : args.data;
+  const std::string data_dir = dataset_of(source.manifest, args);
   CacheChoice cache = source.cache;
   if (args.cache_dir_opt && args.cache_dir_opt->count()) cache.dir = args.cache_dir;
   if (!args.cache_precision.empty()) cache.precision = args.cache_precision;
@@ -419,8 +432,7 @@ nlohmann::json mean_over_scenes(const std::vector<nlohmann::json>& scenes) {
 
 nlohmann::json evaluate_vision_json(infer::LoadedRun& run, const EvalArgs& args,
                                     const OutputDir& dir) {
-  const std::string data_dir =
-      args.data.empty() ? run.manifest.at("data").get<std::string>() : args.data;
+  const std::string data_dir = dataset_of(run.manifest, args);
   data::ImageLoadOptions load;
   load.progress = !args.quiet;
   const data::ImageSet images = data::load_transforms_json(data_dir, load);
@@ -533,6 +545,7 @@ void register_eval(CLI::App& app) {
     const std::vector<FlagPath> inputs = {
         {"--model", args->model}, {"--data", args->data}, {"--novel-data", args->novel_data}};
     require_safe_output({"--json", args->json}, inputs, args->run);
+    require_extension({"--json", args->json}, ".json");
     if (!args->novel_data.empty() && !args->run.empty()) {
       std::vector<std::string> own = infer::run_input_folders(args->run);
       if (!args->data.empty()) own.push_back(args->data);

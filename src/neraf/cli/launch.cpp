@@ -294,8 +294,9 @@ void register_launch(CLI::App& app) {
       "several machines run `neraf train` with those flags on each (README, \"Several\n"
       "processes or machines\").\n"
       "Example: neraf launch -n 2 -- train --data demo/ --out runs/demo");
-  cmd->add_option("-n,--nproc", args->nproc, "Number of processes (ranks)")
-      ->transform(whole_number(1, 64))
+  cmd->add_option("-n,--nproc", args->nproc,
+                  "Number of processes (ranks), 2 or more (one process: run neraf train)")
+      ->transform(whole_number(2, 64))
       ->required();
   cmd->add_option("--master-port", args->master_port,
                   "TCP port of rank 0 on 127.0.0.1 (default: a free port)")

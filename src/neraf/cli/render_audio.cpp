@@ -255,6 +255,7 @@ void add_render_loudness(CLI::App& render) {
                         {{"--csv", args->csv}, {"--model", args->field.model}}, args->field.run);
     require_safe_output({"--csv", args->csv}, {{"--model", args->field.model}}, args->field.run);
     require_extension({"--out", args->out}, ".png");
+    if (!args->csv.empty()) require_extension({"--csv", args->csv}, ".csv");
     const LoadedField field = load_field(args->field);
     const infer::AudioRunInfo& info = field.field->info();
     const double yaw = resolve_yaw(args->pose, info.layout, field.name);

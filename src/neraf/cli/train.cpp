@@ -55,6 +55,7 @@ struct TrainArgs {
   CLI::Option* audio_loss_opt = nullptr;
   int64_t grid_resolution = 32;
   CLI::Option* grid_resolution_opt = nullptr;
+  CLI::Option* modality_opt = nullptr;
   int keep = 3;
   int64_t save_every = 0;
   int world_size = 1;
@@ -128,11 +129,13 @@ void register_train(CLI::App& app) {
                                       "--resume; once per scene for a multi-scene audio run")
                           ->expected(1)
                           ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  cmd->add_option("--modality", args->modality,
-                  "What to train: joint (images + RIRs), vision (images only) or audio (RIRs on "
-                  "the frozen field of --vision-run)")
-      ->check(CLI::IsMember({"vision", "audio", "joint"}))
-      ->capture_default_str();
+  args->modality_opt =
+      cmd->add_option(
+             "--modality", args->modality,
+             "What to train: joint (images + RIRs), vision (images only) or audio (RIRs on "
+             "the frozen field of --vision-run)")
+          ->check(CLI::IsMember({"vision", "audio", "joint"}))
+          ->capture_default_str();
   CLI::Option* preset =
       cmd->add_option("--preset", args->preset,
                       "Model and schedule preset: cpu (sized for a few CPU cores, with neraf's "
@@ -352,6 +355,13 @@ void register_train(CLI::App& app) {
     opts.keep = args->keep;
     if (save_every->count()) opts.save_every = args->save_every;
     if (args->resume) {
+      std::error_code ec;  // rank 0 reads the run (the others get its config)
+      require(
+          args->rank > 0 || std::filesystem::is_regular_file(
+                                (std::filesystem::path(args->out) / "config.json").string(), ec),
+          args->out +
+              ": no config.json here, so there is no run to resume; drop --resume to start a "
+              "new run");
       // The run's own config wins; flags that would change the model are refused.
       for (CLI::Option* o : {preset, seed, rays, precision, grid, fraction, vision_run, audio_start,
                              decay_loss, no_relative})
@@ -359,7 +369,7 @@ void register_train(CLI::App& app) {
                                      ": cannot change on --resume (the run's config.json is "
                                      "used); start a new run with --out to change it");
       for (CLI::Option* o : {args->cache_dir_opt, args->cache_precision_opt, args->max_len_opt,
-                             args->audio_loss_opt, args->grid_resolution_opt})
+                             args->audio_loss_opt, args->grid_resolution_opt, args->modality_opt})
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json records "
                                      "it); start a new run with --out to change it");

@@ -125,6 +125,11 @@ RirIndex index_raf(const std::string& dir, ProblemList& problems) {
                        "ids are numbers or \"000123\" strings");
         continue;
       }
+      if (id.empty() || id.find('/') != std::string::npos || id == "." || id == "..") {
+        problems.error(split_path, where + " \"" + id + "\" is not an id",
+                       "ids name folders of data/ (\"000123\"), not paths");
+        continue;
+      }
       std::string folder = (fs::path(dir) / "data" / id).string();
       if (!fs::is_directory(folder, ec) && list[k].is_string()) {
         // "123" written without the zero padding of the folder names

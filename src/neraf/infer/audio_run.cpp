@@ -103,6 +103,8 @@ AudioRunInfo audio_info_from_manifest(const nlohmann::json& a, const std::string
     check(info.sample_rate >= 1 && info.sample_rate <= 768000, "sample_rate", a["sample_rate"],
           "expected 1..768000 Hz");
     check(info.channels >= 1 && info.channels <= 64, "channels", a["channels"], "expected 1..64");
+    check(info.layout != data::AudioLayout::raf || info.channels == 1, "channels", a["channels"],
+          "the raf layout is mono");
     check(s.n_fft >= 2 && s.n_fft <= (1 << 20), "n_fft", a["n_fft"], "expected 2..1048576");
     check(s.win_length >= 1 && s.win_length <= s.n_fft, "win_length", a["win_length"],
           "expected 1..n_fft");

@@ -250,10 +250,12 @@ void validate(const TrainConfig& c, const std::string& where) {
                 "audio.vision_run (one --vision-run per --data)");
   }
   if (c.modality != Modality::vision)
-    require(a.start_step < c.steps,
+    // Steps are numbered 0..steps−1 and audio runs on those after start_step: at least one.
+    require(a.start_step < c.steps - 1,
             where + ".audio.start_step: audio starts after step " + std::to_string(a.start_step) +
-                " (--audio-start-step) but the run has only " + std::to_string(c.steps) +
-                " steps; raise --steps or lower --audio-start-step");
+                " (--audio-start-step) but the run's steps are 0.." + std::to_string(c.steps - 1) +
+                ", so the acoustic field would never train; raise --steps to at least " +
+                std::to_string(a.start_step + 2) + " or lower --audio-start-step");
   check_schedule(a.schedule, where + ".audio.schedule");
 }
 

@@ -57,6 +57,18 @@ void check_out_dir(const std::string& dir, bool force) {
             dir +
                 ": is not a dataset written by neraf synth (no synth_info.json), so --force "
                 "does not replace it; choose a new or empty --out folder");
+    // The whole folder is replaced: anything else in it (a run trained inside it, notes) would
+    // go with it.
+    for (const auto& entry : fs::directory_iterator(dir, ec)) {
+      const std::string name = entry.path().filename().string();
+      const bool ours = name == ".neraf_cache" || name == "binaural_rirs" || name == "data" ||
+                        name == "images" || name == "metadata" || name == "metadata_AudioNeRF" ||
+                        name == "plan.png" || name == "scene.json" || name == "synth_info.json" ||
+                        name == "transforms.json";
+      require(ours, dir + ": holds " + name +
+                        ", which neraf synth did not write; --force replaces the whole folder, "
+                        "so move it out first (or choose a new --out)");
+    }
   }
 }
 

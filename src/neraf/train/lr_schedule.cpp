@@ -7,9 +7,10 @@ namespace neraf::train {
 
 double learning_rate(const infer::ScheduleConfig& s, int64_t step) {
   const int64_t warm_end = s.warmup_start + s.warmup_steps;
+  if (step < s.warmup_start) return s.lr_pre_warmup;  // also when there is no warm-up (0 / 0)
   if (step < warm_end) {
-    const double x = static_cast<double>(std::max<int64_t>(0, step - s.warmup_start)) /
-                     static_cast<double>(s.warmup_steps);
+    const double x =
+        static_cast<double>(step - s.warmup_start) / static_cast<double>(s.warmup_steps);
     const double r = s.warmup_ramp == "sine" ? std::sin(0.5 * M_PI * x) : x;
     return s.lr_pre_warmup + (s.lr - s.lr_pre_warmup) * r;
   }
