@@ -327,10 +327,19 @@ TEST(LayoutSynth, RefusesANonEmptyFolderUnlessForced) {
   EXPECT_TRUE(fs::exists(out / "notes.txt"));
   fs::remove(out / "notes.txt");
   EXPECT_NO_THROW(synthesize(scene, options(out, 1, "raf")));
+  // --force replaces the folder as a whole, so one holding anything synth did not write (notes,
+  // a run trained inside it) is refused, and kept.
   io::write_text_atomically((out / "notes.txt").string(), "keep me");
+  try {
+    synthesize(scene, forced);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("holds notes.txt"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(fs::exists(out / "notes.txt"));
+  fs::remove(out / "notes.txt");
   EXPECT_NO_THROW(synthesize(scene, forced));
   EXPECT_TRUE(fs::exists(out / "data/000000/rir.wav"));
-  EXPECT_FALSE(fs::exists(out / "notes.txt"));  // --force replaces the folder as a whole
   // No temporary files or folders are left behind, beside it or in it.
   for (const auto& e : fs::recursive_directory_iterator(out))
     EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos) << e.path();
