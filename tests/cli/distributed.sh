@@ -139,7 +139,7 @@ wait "$f0"
 [ -e "$B" ] && fail "a refused distributed run left $B behind"
 # A global batch that does not split over the ranks.
 expect_exit 1 "$NERAF" launch -n 2 -- train --data "$S" --out "$B" --rays 255 --threads 1 --quiet
-expect_in "$TMP/err" "--rays 255: the global batch must split evenly over --world-size 2"
+expect_in "$TMP/err" "launch -n 2: the batch of 255 rays (--rays) does not split evenly over 2"
 [ -e "$B" ] && fail "a refused distributed run left $B behind"
 # More threads in all than cores is warned about (launch alone gives each cores / N).
 expect_exit 1 "$NERAF" launch -n 2 -- train --data "$S" --out "$B" --rays 255 --threads "$(nproc)" \

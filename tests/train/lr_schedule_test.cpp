@@ -52,6 +52,13 @@ TEST(LrSchedule, WarmupFromALaterStart) {
   s.warmup_steps = 0;
   EXPECT_DOUBLE_EQ(learning_rate(s, 999), 1e-8);
   EXPECT_NEAR(learning_rate(s, 1000), 2e-3, 1e-16);
+  // A run shortened on --resume to end inside its warm-up: the ramp, then lr_final, never NaN.
+  s.warmup_steps = 100;
+  s.max_steps = 1050;
+  EXPECT_NEAR(learning_rate(s, 1025), 1e-8 + (2e-3 - 1e-8) * 0.25, 1e-18);
+  EXPECT_DOUBLE_EQ(learning_rate(s, 1100), 1e-4);
+  s.max_steps = 1100;
+  EXPECT_DOUBLE_EQ(learning_rate(s, 1100), 1e-4);
 }
 
 TEST(LrSchedule, CpuPresetDecaysOverTheRun) {

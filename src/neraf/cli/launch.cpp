@@ -141,7 +141,7 @@ void check_batches_split(const std::vector<std::string>& command, int n) {
   }
   auto splits = [](int64_t batch) {
     std::string list;
-    for (int d = 1; d <= 64; ++d)
+    for (int d = 2; d <= 64; ++d)
       if (batch % d == 0) list += (list.empty() ? "" : ", ") + std::to_string(d);
     return list;
   };
@@ -149,7 +149,7 @@ void check_batches_split(const std::vector<std::string>& command, int n) {
   if (cfg.modality != infer::Modality::audio && cfg.rays_per_batch % n != 0)
     throw Error("launch -n " + N + ": the batch of " + std::to_string(cfg.rays_per_batch) +
                 " rays (--rays) does not split evenly over " + N + " processes; use -n " +
-                splits(cfg.rays_per_batch) + ", or a --rays that " + N + " divides");
+                splits(cfg.rays_per_batch) + " (if any), or a --rays that " + N + " divides");
   if (cfg.modality != infer::Modality::vision && cfg.audio.batch_size % n != 0)
     throw Error("launch -n " + N + ": the acoustic batch of " +
                 std::to_string(cfg.audio.batch_size) + " slices (preset " + cfg.preset +
@@ -166,7 +166,6 @@ int run_launch(const LaunchArgs& args) {
       require(a != own && a.rfind(std::string(own) + "=", 0) != 0,
               std::string("launch: ") + own +
                   " is set by launch for each process; remove it (use -n and --master-port)");
-  check_batches_split(args.command, args.nproc);
   const int port = args.master_port > 0 ? args.master_port : free_port();
   bool quiet_given = false;
   for (const auto& a : args.command) quiet_given |= a == "--quiet";
@@ -195,6 +194,7 @@ int run_launch(const LaunchArgs& args) {
                  args.nproc, threads, args.nproc * threads, cores, advice.c_str());
   }
 
+  check_batches_split(args.command, args.nproc);
   train::InterruptGuard interrupt;  // Ctrl-C / SIGTERM → forwarded to the children
   std::vector<Child> children(static_cast<size_t>(args.nproc));
   for (int r = 0; r < args.nproc; ++r) {

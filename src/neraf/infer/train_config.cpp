@@ -178,11 +178,9 @@ TrainConfig train_config_from_json(const nlohmann::json& j, const std::string& w
 namespace {
 void check_schedule(const ScheduleConfig& s, const std::string& where) {
   require(s.lr > 0 && s.lr_final > 0, where + ": lr and lr_final must be positive");
-  require(
-      s.warmup_steps >= 0 && s.warmup_start >= 0 && s.max_steps > s.warmup_start + s.warmup_steps,
-      where +
-          ": need warmup_steps, warmup_start >= 0 and warmup_start + warmup_steps < "
-          "max_steps");
+  // max_steps may end inside the warm-up (a run shortened on --resume): learning_rate copes.
+  require(s.warmup_steps >= 0 && s.warmup_start >= 0 && s.max_steps >= 1,
+          where + ": need warmup_steps >= 0, warmup_start >= 0 and max_steps >= 1");
   require(s.warmup_ramp == "linear" || s.warmup_ramp == "sine",
           where + ".warmup_ramp: use linear or sine");
   require(s.eps > 0, where + ".eps: must be positive");
