@@ -173,13 +173,7 @@ int run_launch(const LaunchArgs& args) {
   // torchrun does; more threads than cores in all makes every rank wait on the others.
   const int cores = std::max(1u, std::thread::hardware_concurrency());
   std::vector<std::string> command = args.command;
-  int threads = 0;
-  for (size_t i = 0; i < command.size(); ++i) {
-    if (command[i] == "--threads" && i + 1 < command.size())
-      threads = std::atoi(command[i + 1].c_str());
-    else if (command[i].rfind("--threads=", 0) == 0)
-      threads = std::atoi(command[i].c_str() + 10);
-  }
+  int threads = std::atoi(flag_value(command, "--threads").c_str());
   if (threads == 0) {
     threads = std::max(1, cores / args.nproc);
     command.insert(command.end(), {"--threads", std::to_string(threads)});
