@@ -496,6 +496,95 @@ bad "put --" "$NERAF" launch -n 2 train --data "$BASE/ss" --out @OUT@ --steps 1 
 # P19 a dry signal whose rate cannot be resampled names --in.
 float_wav "$TMP/dry_1hz.wav" 1 1 0.5
 bad "--in $TMP/dry_1hz.wav" "$NERAF" auralize --rir "$WAV" --in "$TMP/dry_1hz.wav" --out @OUT@.wav
+# --- probe round c (docs/results/fresh_probes_2026-12-04.md), fixed in session 12 ---
+# F05/F15 a scene where no sound reaches a microphone in time, absurd acoustics (also --dry-run).
+"$NERAF" synth --preset demo --print-scene >"$TMP/demo_scene.json"
+cp "$TMP/demo_scene.json" "$TMP/sc_slow.json"; json_edit "$TMP/sc_slow.json" 'd["acoustics"]["speed_of_sound"] = 1; d["acoustics"]["rir_length_s"] = 0.05'
+bad "$TMP/sc_slow.json" "$NERAF" synth --scene "$TMP/sc_slow.json" --out @OUT@ --quiet
+bad "$TMP/sc_slow.json" "$NERAF" synth --scene "$TMP/sc_slow.json" --dry-run
+cp "$TMP/demo_scene.json" "$TMP/sc_sos.json"; json_edit "$TMP/sc_sos.json" 'd["acoustics"]["speed_of_sound"] = 1e-9'
+bad "$TMP/sc_sos.json" "$NERAF" synth --scene "$TMP/sc_sos.json" --dry-run
+cp "$TMP/demo_scene.json" "$TMP/sc_yaw.json"; json_edit "$TMP/sc_yaw.json" 'd["sources"][0]["yaw_deg"] = 1e308'
+bad "$TMP/sc_yaw.json" "$NERAF" synth --scene "$TMP/sc_yaw.json" --dry-run
+# F06/F07 --gain-from another room, or an implausible gain.
+bad "--gain-from" "$NERAF" synth --preset shoebox --mics random --mic-count 2 \
+  --gain-from "$BASE/ss" --out @OUT@ --quiet
+fresh ss_gain ss; json_edit "$D/synth_info.json" 'd["gain"] = 1e30'
+bad "$D/synth_info.json" "$NERAF" synth --preset demo --mics random --mic-count 2 \
+  --gain-from "$D" --out @OUT@ --quiet
+D=""
+# F10 camera files: a reflection, a position of 1e300 m, a new size without a focal length, a
+# principal point off the image.
+python3 - "$BASE/run/data.json" "$TMP" <<'PY'
+import json, sys
+c2w = json.load(open(sys.argv[1]))["eval_camera_to_world"][0]
+out = sys.argv[2]
+flip = [[-v for v in c2w[0][:3]] + [c2w[0][3]], c2w[1], c2w[2]]
+json.dump({"camera_to_world": flip}, open(out + "/cam_reflect.json", "w"))
+far = [r[:3] + [1e300 if i == 0 else r[3]] for i, r in enumerate(c2w)]
+json.dump({"camera_to_world": far}, open(out + "/cam_far.json", "w"))
+json.dump({"camera_to_world": c2w, "intrinsics": {"width": 32, "height": 32}},
+          open(out + "/cam_partial.json", "w"))
+json.dump({"camera_to_world": c2w, "intrinsics": {"cx": 1e6}}, open(out + "/cam_cx.json", "w"))
+PY
+for cam in reflect far partial cx; do
+  bad "$TMP/cam_$cam.json" "$NERAF" render view --run "$BASE/run" --pose "$TMP/cam_$cam.json" \
+    --out @OUT@.png
+done
+# F12 a number beyond a double, without the JSON library's text.
+echo '{"version": 1, "source": [1.1, 1.2, 0.9], "poses": [{"mic": [2, 1.5, 1e400]}]}' \
+  >"$TMP/huge_poses.json"
+bad "$TMP/huge_poses.json" "$NERAF" render rir --model "$BASE/model.nrf" \
+  --poses "$TMP/huge_poses.json" --out @OUT@
+grep -q "json.exception" "$TMP/err" && fail "1e400: the JSON library's text: $(cat "$TMP/err")"
+# F20 a feature cache among the run's checkpoints.
+bad "--cache-dir" "$NERAF" train --data "$BASE/ss" --out "$TMP/cache_run" \
+  --cache-dir "$TMP/cache_run/checkpoints" --steps 2 --quiet
+bad "--cache-dir" "$NERAF" calibrate --run "$BASE/run" --cache-dir "$BASE/run/checkpoints" --quiet
+# F23 flags that do not apply, an empty list entry.
+bad "--ablation-runs" "$NERAF" eval --run "$BASE/run" --ablation-runs , --json @OUT@.json \
+  --skip-vision --quiet
+bad "--seed" "$NERAF" auralize --rir "$WAV" --seed 5 --in "$DRY" --out @OUT@.wav
+bad "--max-views" "$NERAF" eval --model "$BASE/model.nrf" --max-views 1 --json @OUT@.json
+# F25 a calibration file given as the checkpoint.
+calib=$(ls "$BASE/run/checkpoints/"*.calibration.pt | head -n 1)
+bad "calibration file" "$NERAF" export --run "$BASE/run" --checkpoint "$calib" --out @OUT@.nrf
+# F26 a frame rate named as --fps, a model given as a run, the two path formats swapped, a
+# checkpoint renamed by hand.
+printf '{"version": 1, "source": [1.1, 1.2, 0.9], "keyframes": [{"time": 0, "mic": [2, 1.5, 2.5], "yaw": 0},
+ {"time": 100000, "mic": [2, 1.5, 2.4], "yaw": 0}]}' >"$TMP/long_path.json"
+bad "--fps" "$NERAF" render trajectory --run "$BASE/run" --path "$TMP/long_path.json" --in "$DRY" \
+  --out @OUT@.wav --frames @OUT@_frames --fps 120
+bad "--model" "$NERAF" render rir --run "$BASE/model.nrf" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 \
+  --out @OUT@.wav
+echo '{"version": 1, "source": [1.1, 1.2, 0.9], "poses": [{"mic": [2, 1.5, 2.5]}]}' >"$TMP/poses.json"
+bad "pose list" "$NERAF" render trajectory --model "$BASE/model.nrf" --path "$TMP/poses.json" \
+  --in "$DRY" --out @OUT@.wav
+fresh run_hugestep run
+for f in "$D"/checkpoints/step-*; do
+  case $f in *.calibration.pt) rm "$f" ;; *) mv "$f" "$D/checkpoints/step-99999999999999999999.pt" ;; esac
+done
+bad "step-99999999999999999999.pt" "$NERAF" render rir --run "$D" --mic 2.0,1.5,2.5 \
+  --src 1.1,1.2,0.9 --out @OUT@.wav
+D=""
+# F21 silence in, silence out: said, not "normalised".
+python3 -c "
+import struct
+open('$TMP/zero.wav','wb').write(b'RIFF'+struct.pack('<I',36+400)+b'WAVEfmt '+struct.pack('<IHHIIHH',16,3,1,22050,88200,4,32)+b'data'+struct.pack('<I',400)+b'\0'*400)"
+run "$NERAF" auralize --rir "$TMP/zero.wav" --in "$DRY" --out "$TMP/zero_wet.wav" --normalize
+[ "$got" -eq 0 ] && grep -q "every sample of the impulse response is zero" "$TMP/err" &&
+  grep -q "silent" "$TMP/out" || fail "auralize of a silent RIR: exit $got, no warning: $(cat "$TMP/err" "$TMP/out")"
+# F08 resume after the data changed under the run: a RIR file or a training picture replaced.
+fresh ss_resume ss
+run "$NERAF" train --data "$D" --out "$TMP/resume_run" --steps 2 --audio-start-step 0 --rays 64 --quiet
+[ "$got" -eq 0 ] || fail "train for the resume case: exit $got: $(tail -c 300 "$TMP/err")"
+wavs=("$D"/binaural_rirs/0/*.wav)
+cp "${wavs[1]}" "${wavs[0]}.new" && mv "${wavs[0]}.new" "${wavs[0]}"
+run "$NERAF" train --out "$TMP/resume_run" --resume --steps 3 --quiet
+[ "$got" -eq 1 ] && grep -q "^error: .*changed since the run was trained" "$TMP/err" ||
+  fail "resume on a changed RIR file: exit $got: $(tail -c 400 "$TMP/err")"
+D=""
+
 # P23 info takes the transforms.json form as train does.
 run "$NERAF" info --no-t60 "$BASE/ss/transforms.json"
 [ "$got" -eq 0 ] || fail "info DS/transforms.json exited $got: $(tail -c 300 "$TMP/err")"

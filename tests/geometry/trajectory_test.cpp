@@ -447,9 +447,26 @@ TEST_F(TrajectoryFile, LoadsAndNamesTheFileInErrors) {
   EXPECT_TRUE(
       Contains(load_error([&] { load_trajectory(broken); }), broken + ": not valid JSON (at byte"));
   const std::string huge = write("huge.json", "{\"version\": 1e400}");
-  EXPECT_TRUE(Contains(load_error([&] { load_trajectory(huge); }), huge + ": not valid JSON"));
+  EXPECT_TRUE(Contains(load_error([&] { load_trajectory(huge); }),
+                       huge + ": a number in it is too large for a double"));
   const std::string empty = write("empty.json", "");
   EXPECT_TRUE(Contains(load_error([&] { load_trajectory(empty); }), empty + ": not valid JSON"));
+}
+
+TEST_F(TrajectoryFile, SwappedFormatsNameTheOtherCommandAndNamesAreEscaped) {
+  const std::string path = write("path.json", walk().dump());
+  EXPECT_TRUE(Contains(load_error([&] { load_pose_list(path); }),
+                       path + ": is a timed path (\"keyframes\"), not a pose list"));
+  const std::string list =
+      write("list.json", R"({"version": 1, "poses": [{"mic": [1, 1, 1], "source": [2, 1, 1]}]})");
+  EXPECT_TRUE(Contains(load_error([&] { load_trajectory(list); }),
+                       list + ": is a pose list (\"poses\"), not a timed path"));
+  // A NUL in a name would end the one-line message there: it is escaped.
+  const std::string nul = write(
+      "nul.json",
+      R"({"version": 1, "poses": [{"name": "a\u0000b", "mic": [1, 1, 1], "source": [2, 1, 1]}]})");
+  const std::string e = load_error([&] { load_pose_list(nul); });
+  EXPECT_TRUE(Contains(e, "\"a\\u0000b\" is not a safe file name")) << e;
 }
 
 TEST_F(TrajectoryFile, PoseListLoads) {
@@ -537,8 +554,11 @@ TEST(PoseList, NamesMustBeSafeFileNames) {
   for (const std::string& bad :
        std::vector<std::string>{"", "../x", "a/b", ".hidden", "..", "a b", "a\\b", "caf\xc3\xa9",
                                 "x\ny", std::string(kMaxPoseNameLength + 1, 'a')}) {
+    // Quoted as JSON quotes it, so a backslash or newline cannot garble the one-line message.
+    std::string quoted;
+    for (char c : bad) quoted += c == '\\' ? "\\\\" : c == '\n' ? "\\n" : std::string(1, c);
     EXPECT_TRUE(Contains(pose_error_with([&](json& j) { j["poses"][1]["name"] = bad; }),
-                         "poses.json: poses[1].name: \"" + bad + "\" is not a safe file name"))
+                         "poses.json: poses[1].name: \"" + quoted + "\" is not a safe file name"))
         << bad;
   }
   EXPECT_TRUE(Contains(pose_error_with([](json& j) { j["poses"][1]["name"] = 5; }),

@@ -1,7 +1,6 @@
 #include "neraf/io/atomic_file.h"
 
 #include <gtest/gtest.h>
-
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -85,7 +84,10 @@ TEST_F(AtomicFileTest, JsonNumberOverflowIsAnErrorNamingTheFile) {
     read_json(huge);
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("huge.json: not valid JSON"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("huge.json: a number in it is too large for a double"),
+              std::string::npos)
+        << e.what();
+    EXPECT_EQ(std::string(e.what()).find("json.exception"), std::string::npos) << e.what();
   }
 }
 
@@ -97,8 +99,8 @@ TEST_F(AtomicFileTest, RefusesToReplaceAnythingButARegularFile) {
   fs::create_symlink(real, link);
   const fs::path fifo = dir_ / "fifo";
   ASSERT_EQ(::mkfifo(fifo.c_str(), 0644), 0);
-  for (const auto& [path, kind] : {std::pair{link, "symbolic link"}, std::pair{fifo, "FIFO"},
-                                   std::pair{dir_, "folder"}}) {
+  for (const auto& [path, kind] :
+       {std::pair{link, "symbolic link"}, std::pair{fifo, "FIFO"}, std::pair{dir_, "folder"}}) {
     try {
       write_text_atomically(path.string(), "new");
       FAIL() << path;
@@ -193,8 +195,7 @@ TEST_F(AtomicFileTest, FolderLockRefusesASecondWriterAndNamesThePid) {
       const FolderLock second(dir_.string());
       FAIL();
     } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("PID " + std::to_string(::getpid())),
-                std::string::npos)
+      EXPECT_NE(std::string(e.what()).find("PID " + std::to_string(::getpid())), std::string::npos)
           << e.what();
     }
   }
@@ -214,7 +215,8 @@ TEST_F(AtomicFileTest, JsonKeyGivenTwiceIsAnError) {
         << e.what();
   }
   // The same key in different objects is fine.
-  write_text_atomically(twice, R"({"a": {"size": 1}, "b": {"size": 2}, "c": [{"k": 1}, {"k": 2}]})");
+  write_text_atomically(twice,
+                        R"({"a": {"size": 1}, "b": {"size": 2}, "c": [{"k": 1}, {"k": 2}]})");
   EXPECT_EQ(read_json(twice)["b"]["size"], 2);
 }
 

@@ -297,6 +297,51 @@ TEST(LayoutSynth, AGivenGainScalesTheWholeSet) {
   for (const auto& d : {a, b}) fs::remove_all(d);
 }
 
+TEST(LayoutSynth, GainFromChecksTheRoomAndThePlausibleRange) {
+  Scene scene = small_scene();
+  scene.cameras.train_count = 1;
+  scene.cameras.eval_count = 0;
+  const fs::path a = temp_dir("gain_from");
+  const SynthSummary written = synthesize(scene, options(a, 2, "raf"));
+  EXPECT_DOUBLE_EQ(synthesized_gain(a.string()).value(), written.gain);
+  EXPECT_FALSE(room_difference(scene, a.string()).has_value());
+  Scene bigger = scene;
+  bigger.size.x += 1;
+  EXPECT_EQ(room_difference(bigger, a.string()).value_or(""), "size");
+  for (const json& bad : {json(1e30), json(0.0), json("0.5")}) {
+    json info = io::read_json((a / "synth_info.json").string());
+    info["gain"] = bad;
+    io::write_json_atomically((a / "synth_info.json").string(), info);
+    try {
+      synthesized_gain(a.string());
+      ADD_FAILURE() << "accepted gain " << bad;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("synth_info.json: \"gain\" must be"), std::string::npos)
+          << e.what();
+    }
+  }
+  fs::remove_all(a);
+}
+
+TEST(LayoutSynth, ARoomWhereNoSoundArrivesInTimeIsRefusedBeforeWriting) {
+  Scene scene = small_scene();
+  scene.acoustics.speed_of_sound = 1;  // 0.1 m within the 0.1 s RIRs: no pair is that close
+  const SynthPlan plan = plan_synthesis(scene, "raf", 2);
+  try {
+    check_sound_reaches_microphones(scene, plan, "scene \"small\"");
+    ADD_FAILURE() << "accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("scene \"small\": every RIR would be silent", 0), 0u)
+        << e.what();
+  }
+  const fs::path out = temp_dir("silent");
+  fs::remove_all(out);
+  EXPECT_THROW(synthesize(scene, options(out, 2, "raf")), Error);
+  EXPECT_FALSE(fs::exists(out));
+  scene.acoustics.speed_of_sound = 343;
+  EXPECT_NO_THROW(check_sound_reaches_microphones(scene, plan, "scene"));
+}
+
 TEST(LayoutSynth, RefusesANonEmptyFolderUnlessForced) {
   Scene scene = small_scene();
   scene.cameras.train_count = 1;

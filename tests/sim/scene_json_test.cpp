@@ -73,7 +73,15 @@ TEST(SceneJson, TypeErrorsNameThePath) {
   EXPECT_EQ(error_with([](json& j) { j["cameras"]["width"] = 4; }),
             "scene.json: cameras.width: must be a whole number of pixels in [8, 8192]");
   EXPECT_EQ(error_with([](json& j) { j["acoustics"]["rir_length_s"] = -1; }),
-            "scene.json: acoustics.rir_length_s: must be a number of seconds in (0, 20]");
+            "scene.json: acoustics.rir_length_s: must be a number of seconds in [0.001, 20]");
+  // Positive but absurd values are refused when the scene is read (so --dry-run sees them).
+  EXPECT_EQ(error_with([](json& j) { j["acoustics"]["rir_length_s"] = 1e-9; }),
+            "scene.json: acoustics.rir_length_s: must be a number of seconds in [0.001, 20]");
+  EXPECT_EQ(
+      error_with([](json& j) { j["acoustics"]["speed_of_sound"] = 1e-9; }),
+      "scene.json: acoustics.speed_of_sound: must be a number of m/s in [1, 10000] (air: 343)");
+  EXPECT_EQ(error_with([](json& j) { j["sources"][0]["yaw_deg"] = 1e308; }),
+            "scene.json: sources[0].yaw_deg: must be a number of degrees in [-1e6, 1e6]");
   EXPECT_EQ(error_with([](json& j) {
               j["furniture"] = json::object();
             }).rfind("scene.json: furniture: must be a list", 0),

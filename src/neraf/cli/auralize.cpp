@@ -62,11 +62,17 @@ void auralize_and_write(const io::AudioBuffer& rir, const std::string& rir_name,
                 "-channel impulse response " + rir_name +
                 "; use mono dry audio, a mono RIR, or equal channel counts");
   }
+  if (dsp::peak_abs(rir) == 0.0f)
+    warn(rir_name + ": every sample of the impulse response is zero, so the output is silence");
+  if (dsp::peak_abs(dry) == 0.0f)
+    warn(dry_path + ": every sample is zero, so the output is silence");
   io::AudioBuffer wet = dsp::auralize(rir, dry);
 
   const float peak = dsp::peak_abs(wet);
   std::string level;
-  if (args.normalize) {
+  if (peak == 0.0f) {
+    level = "silent (every sample is zero)";
+  } else if (args.normalize) {
     const float gain = dsp::normalize_peak(wet, 0.99f);
     level = "peak-normalised to 0.99 (gain " + format_db(gain, "dB") + ")";
   } else {
@@ -116,7 +122,7 @@ void register_auralize(CLI::App& app) {
   cmd->add_flag("--normalize", args->normalize,
                 "Scale the result so its peak is 0.99 (same gain on all channels). Without it the "
                 "level is kept and a warning is printed if the result would clip");
-  cmd->callback([args, rir_opt, run_opt, model_opt, pose_opts] {
+  cmd->callback([cmd, args, rir_opt, run_opt, model_opt, pose_opts] {
     // Checked here rather than with ->required(): --rir, --run and --model are alternatives;
     // still usage errors (exit 2).
     const bool field = run_opt->count() > 0 || model_opt->count() > 0;
@@ -141,6 +147,11 @@ void register_auralize(CLI::App& app) {
       throw CLI::ValidationError(
           "--mic/--src/--yaw/--src-yaw: only with --run or --model (a field to render); a --rir "
           "file is used as it is");
+    for (const char* flag : {"--seed", "--allow-outside"})
+      if (cmd->count(flag) > 0)
+        throw CLI::ValidationError(std::string(flag) +
+                                   ": only with --run or --model (it sets how a field's RIR is "
+                                   "rendered); a --rir file is used as it is, so drop it");
     const io::AudioBuffer rir = io::read_audio(args->rir_path);
     auralize_and_write(rir, args->rir_path, args->dry_path, *args);
   });

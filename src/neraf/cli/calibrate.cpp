@@ -1,12 +1,17 @@
 // `neraf calibrate`: the calibration stage of a run on its own (infer/calibration.h). Training
 // runs it at its end; a run stopped before (Ctrl-C, a kill) or an older checkpoint is
 // calibrated with this.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
 #include "neraf/cli/commands.h"
+#include "neraf/cli/flag_checks.h"
 #include "neraf/data/rir_set.h"
 #include "neraf/infer/calibration.h"
 #include "neraf/infer/run.h"
@@ -28,6 +33,13 @@ struct CalibrateArgs {
 };
 
 void run_calibrate(const CalibrateArgs& args) {
+  infer::run_config_file(args.run_dir);  // a run this user may read
+  // The calibration is written beside the checkpoint: there is no other place to put it.
+  require(::access(args.run_dir.c_str(), W_OK) == 0,
+          args.run_dir + ": the run folder is not writable (" + std::strerror(errno) +
+              "); calibrate writes its file beside the checkpoint, so run it as the run's owner "
+              "or on a writable copy of the run");
+  require_cache_folder({"--cache-dir", args.cache_dir}, args.run_dir);
   const io::FolderLock lock(args.run_dir);  // not while training writes the run
   const std::string manifest_path = args.run_dir + "/data.json";
   const nlohmann::json manifest = io::read_json(manifest_path);

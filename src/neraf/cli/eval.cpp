@@ -1,11 +1,14 @@
 // `neraf eval`: evaluates a trained run on its held-out data and writes one JSON with a key per
 // modality ("vision" here; the acoustic branch adds "audio" in evaluate_run_json below).
 #include <torch/torch.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <numeric>
@@ -61,9 +64,12 @@ struct EvalArgs {
 std::vector<std::string> split_commas(const std::string& s) {
   std::vector<std::string> out;
   size_t start = 0;
-  while (start <= s.size()) {
+  while (!s.empty() && start <= s.size()) {
     const size_t end = std::min(s.find(',', start), s.size());
-    if (end > start) out.push_back(s.substr(start, end - start));
+    // "a,,b" or a stray comma is a typo, not "no run": it would silently drop an ablation.
+    require(end > start, "--ablation-runs " + s +
+                             ": an empty entry; give run folders separated by single commas");
+    out.push_back(s.substr(start, end - start));
     start = end + 1;
   }
   return out;
@@ -509,8 +515,11 @@ void register_eval(CLI::App& app) {
                   "(default, whatever trained them) or bf16 (as a bf16 run trained)")
       ->check(CLI::IsMember({"fp32", "bf16"}))
       ->needs(run_opt);
-  cmd->add_option("--max-views", args->max_views, "Evaluate only the first N eval views")
-      ->transform(whole_number(1, 10000000));
+  cmd->add_option("--max-views", args->max_views,
+                  "Vision: evaluate only the first N eval views (not with --model: an exported "
+                  "model has no radiance field)")
+      ->transform(whole_number(1, 10000000))
+      ->excludes(model_opt);
   cmd->add_option("--threads", args->threads,
                   "CPU threads (default: all cores; at most 4 x the cores)")
       ->transform(thread_count());
@@ -546,6 +555,7 @@ void register_eval(CLI::App& app) {
         {"--model", args->model}, {"--data", args->data}, {"--novel-data", args->novel_data}};
     require_safe_output({"--json", args->json}, inputs, args->run);
     require_extension({"--json", args->json}, ".json");
+    split_commas(args->ablation_runs);  // a typo in the list fails now, not after the scoring
     if (!args->novel_data.empty() && !args->run.empty()) {
       std::vector<std::string> own = infer::run_input_folders(args->run);
       if (!args->data.empty()) own.push_back(args->data);
@@ -560,6 +570,17 @@ void register_eval(CLI::App& app) {
     std::vector<FlagPath> folder_inputs = inputs;
     folder_inputs.push_back({"--json", args->json});
     require_safe_output_folder({"--images", args->images}, folder_inputs, args->run);
+    require_cache_folder({"--cache-dir", args->cache_dir}, args->run);
+    if (args->images.empty()) {
+      // The PNGs and per-RIR CSVs go beside the run or model unless --images says otherwise.
+      const std::string beside =
+          args->run.empty() ? std::filesystem::path(args->model).parent_path().string() : args->run;
+      require(::access(beside.empty() ? "." : beside.c_str(), W_OK) == 0,
+              (beside.empty() ? std::string(".") : beside) + ": not writable (" +
+                  std::strerror(errno) +
+                  "); eval writes its comparison PNGs and per-RIR CSVs there by default: pass "
+                  "--images DIR, a writable folder for them");
+    }
     if (!args->model.empty()) {
       const infer::ExportedModel model = infer::load_exported_model(args->model);
       const nlohmann::json& meta = model.metadata();
@@ -596,10 +617,7 @@ void register_eval(CLI::App& app) {
       io::write_json_atomically(args->json, out);
       return;
     }
-    const std::string config_path = (std::filesystem::path(args->run) / "config.json").string();
-    std::error_code ec;
-    require(std::filesystem::is_regular_file(config_path, ec),
-            args->run + ": not a training run (no config.json); check --run");
+    const std::string config_path = infer::run_config_file(args->run);
     const infer::TrainConfig cfg = infer::read_run_config(config_path);
     nlohmann::json out = {{"run", args->run}};
     const std::string shown =

@@ -139,6 +139,14 @@ void require_safe_output_folder(const FlagPath& out, const std::vector<FlagPath>
   require_outside(out, protected_folders(out.path, inputs, run_dir));
 }
 
+void require_cache_folder(const FlagPath& cache, const std::string& run_dir) {
+  if (cache.path.empty() || run_dir.empty()) return;
+  const std::string checkpoints = (fs::path(run_dir) / "checkpoints").string();
+  require(!inside(cache.path, checkpoints),
+          cache.flag + " " + cache.path + ": is inside " + checkpoints +
+              " (the run's checkpoints folder); choose a cache folder outside it");
+}
+
 void require_extension(const FlagPath& out, const std::string& extension) {
   std::string ext = fs::path(out.path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),

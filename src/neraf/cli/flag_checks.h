@@ -40,6 +40,10 @@ void require_safe_output(const FlagPath& out, const std::vector<FlagPath>& input
 void require_safe_output_folder(const FlagPath& out, const std::vector<FlagPath>& inputs,
                                 const std::string& run_dir = "");
 
+// --cache-dir: any folder but one inside the run's checkpoints folder (whose files retention and
+// resume manage). An empty path (flag not given) passes.
+void require_cache_folder(const FlagPath& cache, const std::string& run_dir);
+
 // Usage error unless `path` ends in `extension` (".png", ".nrf"), case-insensitively: an output
 // named for another format would hold bytes its name does not promise.
 void require_extension(const FlagPath& out, const std::string& extension);

@@ -65,6 +65,8 @@ std::vector<float> mono_dry(const std::string& path, int rate) {
   std::vector<float> mono(static_cast<size_t>(dry.num_frames()), 0.0f);
   for (const auto& ch : dry.channels)
     for (size_t i = 0; i < mono.size(); ++i) mono[i] += ch[i] / dry.num_channels();
+  if (std::all_of(mono.begin(), mono.end(), [](float v) { return v == 0.0f; }))
+    warn(path + ": every sample is zero (or the channels cancel), so the output is silence");
   return mono;
 }
 
@@ -96,11 +98,20 @@ infer::LoadedRun load_view_run(const FieldArgs& field_args) {
                          own ? field_args.checkpoint : "");
 }
 
-// One PNG per video frame at `fps` into `dir`: the radiance field seen from the listener, facing
-// its heading.
-void render_frames(infer::LoadedRun& run, const geometry::Trajectory& path, double fps,
-                   double duration_s, const std::string& dir) {
-  const std::vector<geometry::TimedPose> poses = geometry::sample_trajectory(path, fps, duration_s);
+// The path sampled `rate` times a second; a refused rate names `flag`, the one that set it.
+std::vector<geometry::TimedPose> sample_for(const geometry::Trajectory& path, double rate,
+                                            double duration_s, const std::string& flag) {
+  try {
+    return geometry::sample_trajectory(path, rate, duration_s);
+  } catch (const Error& e) {
+    throw Error(flag + ": " + e.what());
+  }
+}
+
+// One PNG per video frame (`poses`, sampled at --fps) into `dir`: the radiance field seen from
+// the listener, facing its heading.
+void render_frames(infer::LoadedRun& run, const std::vector<geometry::TimedPose>& poses,
+                   const std::string& dir) {
   Progress progress("render frames", static_cast<int64_t>(poses.size()),
                     ProgressOptions{"frame", 0.2, 10.0, true});
   for (size_t i = 0; i < poses.size(); ++i) {
@@ -141,7 +152,11 @@ void run_trajectory(const TrajectoryArgs& args) {
   }
   // The poses of the updates; the path holds its last pose after its end.
   const std::vector<geometry::TimedPose> updates =
-      geometry::sample_trajectory(path, args.rate_hz, duration_s);
+      sample_for(path, args.rate_hz, duration_s, "--rate");
+  // Checked before the audio work, which takes longer than this.
+  const std::vector<geometry::TimedPose> frames =
+      view_run ? sample_for(path, args.fps, path.duration(), "--fps")
+               : std::vector<geometry::TimedPose>();
   for (const geometry::TimedPose& p : updates) {
     char where[96];
     std::snprintf(where, sizeof where, "%s at t = %.3f s:", args.path.c_str(), p.time);
@@ -210,9 +225,8 @@ void run_trajectory(const TrajectoryArgs& args) {
   }
   if (view_run) {
     // The frames first: a failure there leaves neither the frames nor the WAV.
-    io::write_folder_atomically(args.frames_dir, [&](const std::string& tmp) {
-      render_frames(*view_run, path, args.fps, path.duration(), tmp);
-    });
+    io::write_folder_atomically(
+        args.frames_dir, [&](const std::string& tmp) { render_frames(*view_run, frames, tmp); });
     std::printf("wrote %s: frames at %.3g fps\n", args.frames_dir.c_str(), args.fps);
   }
   io::write_audio(args.out, result);

@@ -66,8 +66,10 @@ void run_synth(SynthArgs a) {
                 plan.layout.c_str(), plan.jobs.size(), a.plan_only.c_str());
     return;
   }
+  // Before --out and before any work (synthesize checks it too, naming the scene, not the file).
+  const sim::SynthPlan plan = sim::plan_synthesis(scene, a.layout, a.seed);
+  sim::check_sound_reaches_microphones(scene, plan, where);
   if (a.dry_run) {
-    const sim::SynthPlan plan = sim::plan_synthesis(scene, a.layout, a.seed);
     std::printf(
         "scene \"%s\", %s layout: %zu RIRs (%zu microphone positions x %zu heading(s) x %zu "
         "source(s)), %d channel(s) at %d Hz, %.3g s each; %zu + %zu images at %dx%d\n",
@@ -102,10 +104,19 @@ void run_synth(SynthArgs a) {
     opt.gain = *gain;
     // A binaural and a mono set are not at one scale (the HRTF changes the level).
     const std::string info_path = a.gain_from + "/synth_info.json";
-    const std::string other = io::read_json(info_path).value("layout", std::string());
+    const nlohmann::json info = io::read_json(info_path);
+    const std::string other = info.contains("layout") && info["layout"].is_string()
+                                  ? info["layout"].get<std::string>()
+                                  : "";
     require(other.empty() || other == a.layout,
             "--gain-from " + a.gain_from + ": is a " + other + " set; give a " + a.layout +
                 " set of the same room (--layout " + a.layout + ")");
+    // Another room's gain puts this one at an arbitrary scale (its loudest pair is elsewhere).
+    if (const std::optional<std::string> differs = sim::room_difference(scene, a.gain_from))
+      throw Error("--gain-from " + a.gain_from + ": is another room than " + where + " (" +
+                  *differs +
+                  " differs in scene.json); give a folder synthesised from the same "
+                  "scene");
   }
   const sim::SynthSummary s = sim::synthesize(scene, opt);
 

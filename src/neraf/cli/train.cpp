@@ -330,6 +330,7 @@ void register_train(CLI::App& app) {
                                      "not train; drop it (or train --modality joint)");
     require(args->grid != "none" || args->grid_resolution_opt->count() == 0,
             "--grid-resolution: --grid none has no grid; drop one of them");
+    require_cache_folder({"--cache-dir", args->cache_dir}, args->out);
     infer::TrainConfig cfg = infer::resolve_train_config(flags);
     cfg.audio.cache_dir = args->cache_dir;
     cfg.audio.cache_precision = args->cache_precision;

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "neraf/io/atomic_file.h"
+#include "neraf/io/sealed_file.h"
 #include "neraf/util/error.h"
 #include "neraf/util/progress.h"
 
@@ -51,7 +52,8 @@ Layout make_layout(const FeatureCacheSpec& s) {
             {"dtype", s.half ? "float16" : "float32"},
             {"lengths_offset", int64_t(0)},
             {"data_offset", int64_t(0)},
-            {"description", s.description}};
+            {"description", s.description},
+            {"sources_fnv1a", s.sources_fnv1a}};
   const int64_t bound = 16 + static_cast<int64_t>(h.dump().size()) + 64;  // offsets grow ≤ 40 chars
   Layout l;
   l.lengths_offset = round_up(bound, 64);
@@ -131,6 +133,7 @@ std::shared_ptr<FeatureCache> FeatureCache::open(const std::string& path,
     s.key = h.at("key");
     s.layout = h.at("layout");
     s.description = h.value("description", "");
+    s.sources_fnv1a = h.value("sources_fnv1a", "");
     s.n_rirs = h.at("n_rirs");
     s.channels = h.at("channels");
     s.n_freq = h.at("n_freq");
@@ -161,8 +164,12 @@ std::shared_ptr<FeatureCache> FeatureCache::open(const std::string& path,
 
 std::shared_ptr<FeatureCache> FeatureCache::build(
     const std::string& path, const FeatureCacheSpec& spec,
-    const std::function<int64_t(int64_t, float*)>& compute, bool progress) {
-  const Layout layout = make_layout(spec);
+    const std::function<int64_t(int64_t, float*)>& compute, bool progress,
+    const std::function<std::string(int64_t)>& source_file) {
+  // The sources' hash is known at the end: lay the header out with a placeholder of its length.
+  FeatureCacheSpec final_spec = spec;
+  final_spec.sources_fnv1a = source_file ? std::string(16, '0') : "";
+  const Layout layout = make_layout(final_spec);
   const int64_t per_rir = spec.max_len * spec.channels * spec.n_freq;
   const int64_t esize = spec.half ? 2 : 4;
 
@@ -196,6 +203,7 @@ std::shared_ptr<FeatureCache> FeatureCache::build(
                 "); free disk space or choose another --cache-dir");
 
     std::vector<int32_t> lengths(static_cast<size_t>(spec.n_rirs), 0);
+    std::vector<uint64_t> source_hashes(source_file ? static_cast<size_t>(spec.n_rirs) : 0);
     std::atomic<int64_t> done{0};
     std::atomic<bool> failed{false};
     std::exception_ptr first_error;
@@ -214,6 +222,7 @@ std::shared_ptr<FeatureCache> FeatureCache::build(
         try {
           const int64_t own = compute(i, buf.data());
           lengths[i] = static_cast<int32_t>(own);
+          if (source_file) source_hashes[i] = io::fnv1a64(io::read_text_file(source_file(i)));
           const int64_t offset = layout.data_offset + i * per_rir * esize;
           if (spec.half) {
             for (int64_t k = 0; k < per_rir; ++k) half_buf[k] = c10::Half(buf[k]);
@@ -235,11 +244,20 @@ std::shared_ptr<FeatureCache> FeatureCache::build(
 
     // Header and lengths last: an interrupted build never leaves a file that looks complete (and
     // the temporary name is only renamed after this function returns).
+    if (source_file) {
+      std::string all;
+      for (uint64_t h : source_hashes) all.append(reinterpret_cast<const char*>(&h), sizeof h);
+      final_spec.sources_fnv1a = hash_hex(all);
+    }
+    const Layout final_layout = make_layout(final_spec);
+    require(final_layout.lengths_offset == layout.lengths_offset &&
+                final_layout.data_offset == layout.data_offset,
+            tmp + ": internal error: the feature cache header changed size");
     std::vector<char> head(static_cast<size_t>(layout.lengths_offset), ' ');
     std::memcpy(head.data(), kMagic, 8);
-    const uint64_t n = layout.header.size();
+    const uint64_t n = final_layout.header.size();
     std::memcpy(head.data() + 8, &n, 8);
-    std::memcpy(head.data() + 16, layout.header.data(), layout.header.size());
+    std::memcpy(head.data() + 16, final_layout.header.data(), final_layout.header.size());
     pwrite_all(fd, head.data(), head.size(), 0, tmp);
     pwrite_all(fd, lengths.data(), lengths.size() * 4, layout.lengths_offset, tmp);
     require(::fsync(fd) == 0, tmp + ": fsync failed (" + std::string(std::strerror(errno)) +

@@ -11,7 +11,8 @@
 //   [16, 16 + n)         JSON header: {"format": "neraf-features", "version": 2, "key": "<hex>",
 //                        "layout", "n_rirs", "channels", "n_freq", "max_len",
 //                        "dtype": "float32" | "float16", "lengths_offset", "data_offset",
-//                        "description": the text the key hashes (parameters + file list summary)}
+//                        "description": the text the key hashes (parameters + file list summary),
+//                        "sources_fnv1a": FNV-1a of the source files' bytes ("" if not hashed)}
 //   [lengths_offset, …)  int32 own STFT length of each RIR [n_rirs] (before padding/cutting)
 //   [data_offset, …)     features [n_rirs][max_len][channels][n_freq] (data_offset is a multiple
 //                        of 4096). Frame-major per RIR so that the (rir, frame) slice a training
@@ -30,6 +31,9 @@ struct FeatureCacheSpec {
   std::string description;
   int64_t n_rirs = 0, channels = 0, n_freq = 0, max_len = 0;
   bool half = false;  // float16 values instead of float32
+  // What the RIR files hold, unlike `key` (their names, sizes and times): a copied dataset has the
+  // same value, a file replaced by another of the same size does not. Filled by build.
+  std::string sources_fnv1a;
 };
 
 // 64-bit FNV-1a of `text` as 16 lowercase hex digits (stable across runs and machines).
@@ -45,10 +49,12 @@ class FeatureCache {
   // Computes every RIR's features with `compute(i, out)` in parallel (OpenMP), where `out` holds
   // max_len·channels·n_freq floats [max_len][channels][n_freq] and the return value is the RIR's
   // own STFT length; writes them to `path` atomically (temporary file + rename) and maps the
-  // result. The first exception thrown by `compute` is rethrown after the workers stop.
-  static std::shared_ptr<FeatureCache> build(const std::string& path, const FeatureCacheSpec& spec,
-                                             const std::function<int64_t(int64_t, float*)>& compute,
-                                             bool progress);
+  // result. The first exception thrown by `compute` is rethrown after the workers stop. With
+  // `source_file` (RIR i's source file), the files' bytes are hashed into spec().sources_fnv1a.
+  static std::shared_ptr<FeatureCache> build(
+      const std::string& path, const FeatureCacheSpec& spec,
+      const std::function<int64_t(int64_t, float*)>& compute, bool progress,
+      const std::function<std::string(int64_t)>& source_file = nullptr);
 
   ~FeatureCache();
   FeatureCache(const FeatureCache&) = delete;

@@ -314,7 +314,9 @@ void attach_features(RirSet& set, const RirIndex& idx, const RirLoadOptions& opt
                     "run the command again to build it");
       return recipe(i, out, warnings[i]);
     };
-    cache = FeatureCache::build(path, spec, compute, options.progress);
+    cache = FeatureCache::build(path, spec, compute, options.progress, [&](int64_t i) {
+      return npy ? set.rirs[i].magnitude_path : set.rirs[i].wav_path;
+    });
     if (options.progress) {
       ProblemList found;
       for (const ProblemList& w : warnings) found.append(w.items());
@@ -421,6 +423,8 @@ RirSet load_rir_set(const std::string& dir, const RirLoadOptions& options) {
 }
 
 // ---------------------------------------------------------------------------------------------
+
+std::string RirSet::sources_hash() const { return cache_ ? cache_->spec().sources_fnv1a : ""; }
 
 torch::Tensor RirSet::features(int64_t i) const {
   require(cache_ != nullptr, "RirSet: features were not loaded (RirLoadOptions::load_features)");

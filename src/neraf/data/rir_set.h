@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "neraf/data/audio_layout.h"  // AudioLayout, Aabb
 #include "neraf/data/problem.h"
 #include "neraf/dsp/stft.h"
 #include "neraf/geometry/vec.h"
@@ -33,16 +34,6 @@
 namespace neraf::data {
 
 class FeatureCache;
-
-enum class AudioLayout {
-  soundspaces,  // <scene>/binaural_rirs/{0,90,180,270}/<r>_<s>.wav + metadata/points.txt
-  raf,          // <room>/data/<id>/{rir.wav, rx_pos.txt, tx_pos.txt} + metadata/data-split.json
-};
-const char* to_string(AudioLayout layout);  // "soundspaces" / "raf"
-
-struct Aabb {
-  geometry::Vec3 min, max;
-};
 
 // NeRAF's position normalisation: p' = (p − min)/(max − min); the WHOLE vector becomes 0 when any
 // component of p' lies outside the open interval (0, 1).
@@ -113,6 +104,9 @@ struct RirSet {
 
   int64_t size() const { return static_cast<int64_t>(rirs.size()); }
   bool has_features() const { return cache_ != nullptr; }
+  // FNV-1a of the RIR files' bytes the features were computed from ("" without features, or for
+  // a cache written before neraf hashed them).
+  std::string sources_hash() const;
 
   // Log-magnitude STFT of RIR i, padded/cut to max_len. [C, F, max_len] float32
   torch::Tensor features(int64_t i) const;

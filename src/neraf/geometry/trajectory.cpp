@@ -51,7 +51,7 @@ void check_object(const std::string& where, const json& j, const std::string& pa
       std::string names;
       for (const char* k : known) names += (names.empty() ? "" : ", ") + std::string(k);
       fail(where, path,
-           "unknown key \"" + it.key() + "\" (known keys: " + names +
+           "unknown key " + json_quoted(it.key()) + " (known keys: " + names +
                "); fix the spelling or remove it");
     }
   }
@@ -153,6 +153,11 @@ const json& read_list(const std::string& where, const json& j, const char* key, 
 }
 
 Trajectory parse_trajectory_unchecked(const json& j, const std::string& where) {
+  // The two formats of docs/PATH_FORMAT.md are easily swapped: say which command takes the other.
+  if (j.is_object() && j.contains("poses") && !j.contains("keyframes"))
+    fail(where, "",
+         "is a pose list (\"poses\"), not a timed path (\"keyframes\"); render it with "
+         "neraf render rir --poses");
   check_object(where, j, "", {"version", "description", "source", "keyframes"});
   check_version(where, j);
   check_description(where, j);
@@ -226,11 +231,15 @@ std::string read_name(const std::string& where, const json& j, const std::string
                   std::all_of(name.begin(), name.end(), safe_name_char);
   // The name becomes a file name: anything else could leave the output folder ("../x") or trip
   // up shells.
-  if (!ok) fail(where, path, "\"" + name + "\" is not a safe file name; use " + rule);
+  if (!ok) fail(where, path, json_quoted(name) + " is not a safe file name; use " + rule);
   return name;
 }
 
 std::vector<NamedPose> parse_pose_list_unchecked(const json& j, const std::string& where) {
+  if (j.is_object() && j.contains("keyframes") && !j.contains("poses"))
+    fail(where, "",
+         "is a timed path (\"keyframes\"), not a pose list (\"poses\"); render it with "
+         "neraf render trajectory --path");
   check_object(where, j, "", {"version", "description", "source", "poses"});
   check_version(where, j);
   check_description(where, j);

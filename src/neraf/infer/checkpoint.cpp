@@ -13,6 +13,12 @@ namespace fs = std::filesystem;
 
 namespace neraf::infer {
 
+namespace {
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+}  // namespace
+
 std::string checkpoint_dir(const std::string& run_dir) {
   return (fs::path(run_dir) / "checkpoints").string();
 }
@@ -40,17 +46,35 @@ std::optional<std::string> latest_checkpoint(const std::string& run_dir) {
 }
 
 std::string checkpoint_of_run(const std::string& run_dir, const std::string& checkpoint) {
+  std::error_code ec;
   if (checkpoint.empty()) {
     check_checkpoint_folder(run_dir);
     const auto latest = latest_checkpoint(run_dir);
-    require(latest.has_value(),
-            run_dir + ": no checkpoint yet; train first (neraf train --out " + run_dir + ")");
+    if (!latest) {
+      // A checkpoint renamed by hand is not listed: say so rather than "train first".
+      for (const auto& entry : fs::directory_iterator(checkpoint_dir(run_dir), ec)) {
+        const std::string name = entry.path().filename().string();
+        require(name.rfind("step-", 0) != 0 || !ends_with(name, ".pt") ||
+                    ends_with(name, ".calibration.pt"),
+                entry.path().string() +
+                    ": not named as neraf names checkpoints (step-NNNNNNNNN.pt, 9 digits), so "
+                    "it is not used; rename it to its step or remove it");
+      }
+      throw Error(run_dir + ": no checkpoint yet; train first (neraf train --out " + run_dir + ")");
+    }
     return *latest;
   }
-  std::error_code ec;
   const fs::path parent = fs::absolute(checkpoint, ec).parent_path();
   require(fs::is_regular_file(checkpoint, ec),
           "--checkpoint " + checkpoint + ": no such file; pick one of " + checkpoint_dir(run_dir));
+  require(!ends_with(checkpoint, ".calibration.pt"),
+          "--checkpoint " + checkpoint +
+              ": is a calibration file; give the checkpoint beside it (the same name without "
+              "\".calibration\")");
+  require(checkpoint_step_from_name(checkpoint) >= 0,
+          "--checkpoint " + checkpoint +
+              ": not named as neraf names checkpoints (step-NNNNNNNNN.pt); pick one of " +
+              checkpoint_dir(run_dir));
   require(fs::equivalent(parent, checkpoint_dir(run_dir), ec),
           "--checkpoint " + checkpoint + ": not a checkpoint of the run " + run_dir +
               " (it must be in " + checkpoint_dir(run_dir) +
@@ -95,7 +119,11 @@ void load_archive(torch::serialize::InputArchive& archive, const std::string& pa
 
 void load_archive_bytes(torch::serialize::InputArchive& archive, const std::string& file,
                         const std::string& path) {
-  const std::string fix = "; delete it to resume from the previous checkpoint";
+  // A damaged calibration file is fitted again; a damaged checkpoint is skipped on resume.
+  const std::string fix = ends_with(path, ".calibration.pt")
+                              ? "; delete it and run neraf calibrate --run " +
+                                    fs::path(path).parent_path().parent_path().string()
+                              : "; delete it to resume from the previous checkpoint";
   try {
     if (io::has_magic(file,
                       "PK\x03\x04")) {  // a zip archive: written before checkpoints were sealed

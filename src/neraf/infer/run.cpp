@@ -19,49 +19,6 @@ namespace {
 constexpr const char* kManifestFormat = "neraf-run-data-1";
 }  // namespace
 
-nlohmann::json intrinsics_json(const data::Intrinsics& k) {
-  return {{"fx", k.fx},       {"fy", k.fy},         {"cx", k.cx}, {"cy", k.cy},
-          {"width", k.width}, {"height", k.height}, {"k1", k.k1}, {"k2", k.k2},
-          {"k3", k.k3},       {"p1", k.p1},         {"p2", k.p2}};
-}
-
-data::Intrinsics intrinsics_from_json(const nlohmann::json& j, const std::string& where) {
-  require(j.is_object(), where + ": expected an object with fx, fy, cx, cy, width, height");
-  data::Intrinsics k;
-  auto num = [&](const char* key, double fallback, bool required) {
-    if (!j.contains(key)) {
-      require(!required, where + "." + key + ": missing");
-      return fallback;
-    }
-    require(j[key].is_number(), where + "." + key + ": expected a number");
-    return j[key].get<double>();
-  };
-  k.fx = num("fx", 0, true);
-  k.fy = num("fy", 0, true);
-  k.cx = num("cx", 0, true);
-  k.cy = num("cy", 0, true);
-  // Whole pixels, checked before the conversion (16.5 or 1e30 pixels is no image size).
-  auto pixels = [&](const char* key) {
-    const double v = num(key, 0, true);
-    require(v == std::floor(v) && v >= 1 && v <= 16384,
-            where + ": width and height must be whole numbers in 1..16384 (" + key + " is " +
-                j[key].dump() + ")");
-    return static_cast<int>(v);
-  };
-  k.width = pixels("width");
-  k.height = pixels("height");
-  k.k1 = num("k1", 0, false);
-  k.k2 = num("k2", 0, false);
-  k.k3 = num("k3", 0, false);
-  k.p1 = num("p1", 0, false);
-  k.p2 = num("p2", 0, false);
-  require(k.fx > 0 && k.fy > 0 && std::isfinite(k.fx) && std::isfinite(k.fy),
-          where + ": fx and fy must be positive");
-  require(k.width > 0 && k.height > 0 && k.width <= 16384 && k.height <= 16384,
-          where + ": width and height must be in 1..16384");
-  return k;
-}
-
 namespace {
 
 nlohmann::json matrix_json(const torch::Tensor& m) {  // [3, 4]
@@ -181,34 +138,6 @@ data::Intrinsics manifest_intrinsics(const nlohmann::json& m, int64_t eval_index
                               "data.json");
 }
 
-bool is_multiscene(const nlohmann::json& m) {
-  return m.is_object() && m.contains("scenes") && m["scenes"].is_array();
-}
-
-std::vector<std::string> scene_names(const nlohmann::json& m) {
-  std::vector<std::string> out;
-  if (!is_multiscene(m)) return out;
-  for (const auto& s : m["scenes"]) out.push_back(s.value("name", std::string("?")));
-  return out;
-}
-
-int64_t find_scene(const nlohmann::json& m, const std::string& selector, const std::string& run_dir,
-                   const std::string& flag) {
-  const std::vector<std::string> names = scene_names(m);
-  std::string list;
-  for (size_t i = 0; i < names.size(); ++i)
-    list += (i ? ", " : "") + std::to_string(i) + " " + names[i];
-  for (size_t i = 0; i < names.size(); ++i)
-    if (names[i] == selector) return static_cast<int64_t>(i);
-  const bool digits = !selector.empty() && selector.size() < 10 &&
-                      selector.find_first_not_of("0123456789") == std::string::npos;
-  if (digits && std::stoll(selector) < static_cast<long long>(names.size()))
-    return std::stoll(selector);
-  throw Error(flag + " " + selector + ": " + run_dir + " has no such scene; its scenes are " +
-              (list.empty() ? std::string("none (it is a one-scene run: drop ") + flag + ")"
-                            : list + " (give a name or an index)"));
-}
-
 int64_t scene_flag(const std::string& run_dir, const std::string& selector,
                    const std::string& flag) {
   if (selector.empty()) return -1;
@@ -267,16 +196,30 @@ std::vector<std::string> run_input_folders(const std::string& run_dir) {
   return folders;
 }
 
+std::string run_config_file(const std::string& run_dir) {
+  std::error_code ec;
+  const fs::file_status folder = fs::status(run_dir, ec);
+  require(fs::exists(folder), run_dir + ": no such run folder; check --run");
+  require(fs::is_directory(folder), run_dir + ": is a file, not a run folder; " +
+                                        (fs::path(run_dir).extension() == ".nrf"
+                                             ? "an exported model goes to --model"
+                                             : "point --run at a neraf train --out folder"));
+  const std::string config_path = run_file(run_dir, "config.json");
+  const bool found = fs::is_regular_file(config_path, ec);
+  require(ec != std::errc::permission_denied,
+          run_dir +
+              ": may not be read (permission denied); run as the run's owner or give "
+              "yourself read access to the folder");
+  require(found, run_dir +
+                     ": not a training run (no config.json); point --run at a neraf train --out "
+                     "folder");
+  return config_path;
+}
+
 LoadedRun load_run(const std::string& run_dir, torch::Device device,
                    const std::string& checkpoint) {
-  std::error_code ec;
-  const std::string config_path = run_file(run_dir, "config.json");
+  const std::string config_path = run_config_file(run_dir);
   const std::string manifest_path = run_file(run_dir, "data.json");
-  require(fs::is_directory(run_dir, ec), run_dir + ": no such run folder; check --run");
-  require(fs::is_regular_file(config_path, ec),
-          run_dir +
-              ": not a training run (no config.json); point --run at a neraf train --out "
-              "folder");
   LoadedRun run;
   run.run_dir = run_dir;
   run.config = read_run_config(config_path);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "neraf/data/image_set.h"
+#include "neraf/infer/run_manifest.h"
 #include "neraf/infer/train_config.h"
 #include "neraf/nerf/nerfacto_model.h"
 
@@ -28,17 +29,7 @@ nlohmann::json make_data_manifest(const data::ImageSet& images, const std::strin
 // on; an audio run on another room's grid trains without complaint and learns nothing useful.
 void check_vision_run_data(const std::string& vision_run, const nlohmann::json& data_manifest);
 
-// Multi-scene runs (neraf train with 2+ --data, modality audio): RUN/data.json is
-// {"format", "scenes": [M_0, M_1, ...]}, each M_s a one-scene manifest (make_data_manifest of the
-// scene, with its "audio" entry) plus its "name" (the dataset folder's name, or "scene<s>" when
-// two folders share one). A loaded scene of such a run (load_audio_run with a scene) carries M_s
-// as its manifest, so everything downstream sees an ordinary one-scene run.
-bool is_multiscene(const nlohmann::json& data_manifest);
-std::vector<std::string> scene_names(const nlohmann::json& data_manifest);  // {} for one scene
-// The scene `selector` names (its name, or its index 0..N−1) in a multi-scene manifest;
-// neraf::Error naming `run_dir`, `flag` and the scenes when there is none.
-int64_t find_scene(const nlohmann::json& data_manifest, const std::string& selector,
-                   const std::string& run_dir, const std::string& flag = "--scene");
+// Multi-scene runs: is_multiscene, scene_names and find_scene (run_manifest.h).
 // `--scene` of a command on RUN: −1 when `selector` is empty, else find_scene on RUN/data.json.
 int64_t scene_flag(const std::string& run_dir, const std::string& selector,
                    const std::string& flag = "--scene");
@@ -52,6 +43,10 @@ std::vector<std::string> name_scenes(const std::vector<std::string>& data_dirs);
 // (config.json audio.vision_run / vision_runs). Best effort: a missing or damaged file adds
 // nothing (loading the run reports it).
 std::vector<std::string> run_input_folders(const std::string& run_dir);
+
+// RUN_DIR/config.json, or neraf::Error saying why RUN_DIR is not a readable run (no such folder, a
+// file (an exported model belongs to --model), a folder it may not read, no config.json).
+std::string run_config_file(const std::string& run_dir);
 
 // A trained run, ready for rendering (model in eval mode on `device`).
 struct LoadedRun {
@@ -71,9 +66,6 @@ LoadedRun load_run(const std::string& run_dir, torch::Device device = torch::kCP
 torch::Tensor manifest_eval_poses(const nlohmann::json& manifest);
 // eval_index −1: the default camera (first training frame).
 data::Intrinsics manifest_intrinsics(const nlohmann::json& manifest, int64_t eval_index);
-// {"fx","fy","cx","cy","width","height"[,"k1","k2","k3","p1","p2"]} ↔ Intrinsics (checked;
-// errors name `where`).
-data::Intrinsics intrinsics_from_json(const nlohmann::json& j, const std::string& where);
-nlohmann::json intrinsics_json(const data::Intrinsics& k);
+// intrinsics_from_json / intrinsics_json: run_manifest.h.
 
 }  // namespace neraf::infer

@@ -11,6 +11,7 @@
 #include "neraf/io/json_file.h"
 #include "neraf/nerf/render_image.h"
 #include "neraf/util/error.h"
+#include "neraf/util/json_text.h"
 
 namespace neraf::render {
 
@@ -62,6 +63,13 @@ torch::Tensor matrix_from_json(const nlohmann::json& j, const std::string& where
   require(ortho < 1e-3, where +
                             ": the rotation part is not orthonormal (a camera-to-world "
                             "matrix is [R | t] with R a rotation)");
+  // A reflection (determinant -1) is orthonormal too, but no camera; transforms.json refuses both.
+  require(torch::det(R).item<double>() > 0,
+          where +
+              ": the rotation part is a reflection (determinant -1); write a rotation with "
+              "determinant +1");
+  require(m.slice(1, 3, 4).abs().max().item<double>() <= 10000,
+          where + ": the camera position is implausible (a coordinate beyond ±10000 m)");
   return m;
 }
 
@@ -106,8 +114,9 @@ Camera read_camera_file(const std::string& path, const nlohmann::json& manifest)
     for (auto it = object.begin(); it != object.end(); ++it) {
       std::string list;
       for (const std::string& key : known) list += (list.empty() ? "" : ", ") + key;
-      require(known.count(it.key()) > 0,
-              path + ": " + what + "unknown key \"" + it.key() + "\"; the known keys are " + list);
+      require(known.count(it.key()) > 0, path + ": " + what + "unknown key " +
+                                             json_quoted(it.key()) + "; the known keys are " +
+                                             list);
     }
   };
   if (j.is_object()) known_keys(j, {"camera_to_world", "transform_matrix", "intrinsics"}, "");
@@ -127,11 +136,27 @@ Camera read_camera_file(const std::string& path, const nlohmann::json& manifest)
       if (k.contains(from) && !k.contains(to)) k[to] = k[from];
     // Missing fields keep the default camera's values (the principal point is not rescaled when
     // only the size changes: give cx, cy with a new width/height).
+    // A new image size changes what the default focal length and principal point mean.
+    const auto changes = [&](const char* key, int now) {
+      return k.contains(key) && k[key].is_number_integer() && k[key] != now;
+    };
+    const bool resized = changes("width", cam.intrinsics.width) ||
+                         changes("height", cam.intrinsics.height);
+    for (const char* key : {"fx", "fy", "cx", "cy"})
+      require(!resized || k.contains(key),
+              path + ": intrinsics: give fx, fy, cx and cy with a new width or height (" + key +
+                  " is missing; the dataset camera's are for " +
+                  std::to_string(cam.intrinsics.width) + "x" +
+                  std::to_string(cam.intrinsics.height) + ")");
     nlohmann::json merged = {{"fx", cam.intrinsics.fx},       {"fy", cam.intrinsics.fy},
                              {"cx", cam.intrinsics.cx},       {"cy", cam.intrinsics.cy},
                              {"width", cam.intrinsics.width}, {"height", cam.intrinsics.height}};
     for (auto it = k.begin(); it != k.end(); ++it) merged[it.key()] = it.value();
     cam.intrinsics = infer::intrinsics_from_json(merged, path + ": intrinsics");
+    const auto& in = cam.intrinsics;
+    require(in.cx >= 0 && in.cx <= in.width && in.cy >= 0 && in.cy <= in.height,
+            path + ": intrinsics: the principal point (cx, cy) must lie inside the " +
+                std::to_string(in.width) + "x" + std::to_string(in.height) + " image");
   }
   return cam;
 }

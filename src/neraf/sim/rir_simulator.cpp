@@ -484,15 +484,15 @@ RirSimulator::RirSimulator(const Scene& scene, int sample_rate, const Hrtf* hrtf
               " Hz: the 8 kHz octave band needs at least 16000 Hz (and at most 384000)");
   const Acoustics& ac = scene.acoustics;
   require(std::isfinite(ac.speed_of_sound) && ac.speed_of_sound > 1,
-          "scene.json: acoustics.speed_of_sound must be a positive number of m/s (e.g. 343)");
+          "the scene's acoustics.speed_of_sound must be a number of m/s above 1 (air: 343)");
   require(ac.max_order >= 0 && ac.max_order <= kMaxReflectionOrder,
-          "scene.json: acoustics.max_order must be in 0.." + std::to_string(kMaxReflectionOrder) +
+          "the scene's acoustics.max_order must be in 0.." + std::to_string(kMaxReflectionOrder) +
               " (the image count grows as order³)");
   require(std::isfinite(ac.rir_length_s) && ac.rir_length_s > 0 && ac.rir_length_s <= 30,
-          "scene.json: acoustics.rir_length_s must be in (0, 30] seconds");
+          "the scene's acoustics.rir_length_s must be in (0, 30] seconds");
   require(
       geometry::is_finite(scene.size) && scene.size.x > 0 && scene.size.y > 0 && scene.size.z > 0,
-      "scene.json: size must be three positive numbers (metres)");
+      "the scene's size must be three positive numbers (metres)");
   require(options.frac_delay_taps >= 2 && options.frac_delay_taps % 2 == 0 &&
               options.frac_delay_taps <= 128,
           "RirSimOptions.frac_delay_taps must be even and in 2..128");
@@ -513,7 +513,7 @@ RirSimulator::RirSimulator(const Scene& scene, int sample_rate, const Hrtf* hrtf
   m.max_order = ac.max_order;
   m.room = scene.size;
   m.len = static_cast<int>(std::lround(ac.rir_length_s * sample_rate));
-  require(m.len >= 1, "scene.json: acoustics.rir_length_s is shorter than one sample");
+  require(m.len >= 1, "the scene's acoustics.rir_length_s is shorter than one sample");
   m.channels = options.binaural ? 2 : 1;
 
   // --- materials ---

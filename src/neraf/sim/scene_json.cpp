@@ -8,6 +8,7 @@
 #include "neraf/io/json_file.h"
 #include "neraf/sim/microphones.h"
 #include "neraf/util/error.h"
+#include "neraf/util/json_text.h"
 
 namespace neraf::sim {
 
@@ -55,7 +56,7 @@ void check_object(const Ctx& c, const json& j, const std::string& path,
   std::vector<std::string> unknown;
   for (auto it = j.begin(); it != j.end(); ++it) {
     if (std::none_of(known.begin(), known.end(), [&](const char* k) { return it.key() == k; }))
-      unknown.push_back("\"" + it.key() + "\"");
+      unknown.push_back(json_quoted(it.key()));
   }
   if (unknown.empty()) return;
   std::string list, names;
@@ -314,9 +315,11 @@ Scene scene_from_json(const json& j, const std::string& origin) {
   if (const json* m = find(j, "acoustics")) {
     const std::string p = "acoustics";
     check_object(c, *m, p, {"speed_of_sound", "max_order", "rir_length_s"});
-    opt(*m, "speed_of_sound", p, s.acoustics.speed_of_sound, number("a positive number (m/s)"));
+    opt(*m, "speed_of_sound", p, s.acoustics.speed_of_sound,
+        number("a number of m/s in [1, 10000]"));
     opt(*m, "max_order", p, s.acoustics.max_order, integer("a whole number in [0, 60]"));
-    opt(*m, "rir_length_s", p, s.acoustics.rir_length_s, number("a number of seconds in (0, 20]"));
+    opt(*m, "rir_length_s", p, s.acoustics.rir_length_s,
+        number("a number of seconds in [0.001, 20]"));
   }
 
   validate_scene(s, origin);
@@ -416,7 +419,8 @@ void validate_scene(const Scene& s, const std::string& origin) {
     if (!is_finite(b.center)) fail(c, p + ".center", std::string("must be ") + kThreeNumbers);
     if (!(is_finite(b.size) && b.size.x > 0 && b.size.y > 0 && b.size.z > 0))
       fail(c, p + ".size", std::string("must be ") + kThreePositive);
-    if (!std::isfinite(b.yaw_deg)) fail(c, p + ".yaw_deg", "must be a number (degrees)");
+    if (!(std::abs(b.yaw_deg) <= kMaxYawDeg))
+      fail(c, p + ".yaw_deg", "must be a number of degrees in [-1e6, 1e6]");
     check_material(b.material, p + ".material");
     const Vec3 h = furniture_box(b).world_half_extent();
     for (int a = 0; a < 3; ++a) {
@@ -445,7 +449,8 @@ void validate_scene(const Scene& s, const std::string& origin) {
     const Source& src = s.sources[i];
     const std::string p = index("sources", i);
     check_point(src.position, p + ".position", "source");
-    if (!std::isfinite(src.yaw_deg)) fail(c, p + ".yaw_deg", "must be a number (degrees)");
+    if (!(std::abs(src.yaw_deg) <= kMaxYawDeg))
+      fail(c, p + ".yaw_deg", "must be a number of degrees in [-1e6, 1e6]");
     if (src.directivity != "omni" && src.directivity != "cardioid")
       fail(c, p + ".directivity",
            "unknown directivity \"" + src.directivity + "\"; use \"omni\" or \"cardioid\"");
@@ -539,14 +544,16 @@ void validate_scene(const Scene& s, const std::string& origin) {
     fail(c, "light.ambient", "must be a number >= 0");
 
   const auto& ac = s.acoustics;
-  if (!(ac.speed_of_sound > 0 && std::isfinite(ac.speed_of_sound)))
-    fail(c, "acoustics.speed_of_sound", "must be a positive number (m/s)");
+  // Air is 343 m/s, water ~1500, steel ~6000: beyond [1, 10000] m/s a typo is likelier.
+  if (!(ac.speed_of_sound >= 1 && ac.speed_of_sound <= 10000))
+    fail(c, "acoustics.speed_of_sound", "must be a number of m/s in [1, 10000] (air: 343)");
   // The simulator's own limit (rir_simulator.cpp): the image count grows as order^3.
   if (!(ac.max_order >= 0 && ac.max_order <= kMaxReflectionOrder))
     fail(c, "acoustics.max_order",
          "must be a whole number in [0, " + std::to_string(kMaxReflectionOrder) + "]");
-  if (!(ac.rir_length_s > 0 && ac.rir_length_s <= 20))
-    fail(c, "acoustics.rir_length_s", "must be a number of seconds in (0, 20]");
+  // At least a millisecond: shorter RIRs are under one STFT hop of either layout.
+  if (!(ac.rir_length_s >= 0.001 && ac.rir_length_s <= 20))
+    fail(c, "acoustics.rir_length_s", "must be a number of seconds in [0.001, 20]");
 }
 
 json scene_to_json(const Scene& s) {

@@ -46,5 +46,7 @@ constexpr double kMaxRoomSizeM = 1000;
 constexpr size_t kMaxFurniture = 1000;
 constexpr int kMaxGridMicrophones = 1000000;
 constexpr int kMaxReflectionOrder = 60;
+// Yaw angles as timed paths bound them (docs/PATH_FORMAT.md): larger ones lose the degrees.
+constexpr double kMaxYawDeg = 1e6;
 
 }  // namespace neraf::sim

@@ -1,5 +1,6 @@
 // plan_synthesis (synthesize.h): which pictures and RIRs a layout writes, without computing them,
 // and how big they are (estimate_synthesis, check_synthesis_size).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -108,6 +109,25 @@ SynthPlan plan_synthesis(const Scene& scene, const std::string& layout, uint64_t
   plan.eval_cameras =
       place_cameras(scene, scene.cameras.eval_count, derive_seed(seed, "cameras-eval"));
   return plan;
+}
+
+void check_sound_reaches_microphones(const Scene& scene, const SynthPlan& plan,
+                                     const std::string& origin) {
+  if (plan.jobs.empty()) return;
+  double nearest = INFINITY;
+  for (const RirJob& job : plan.jobs)
+    nearest = std::min(nearest,
+                       norm(scene.sources[job.source].position - plan.microphones[job.microphone]));
+  const double travel_s = nearest / scene.acoustics.speed_of_sound;
+  if (travel_s < scene.acoustics.rir_length_s) return;
+  char buf[400];
+  std::snprintf(buf, sizeof buf,
+                ": every RIR would be silent: the nearest source and microphone are %.4g m apart, "
+                "%.4g s at %.4g m/s, longer than acoustics.rir_length_s (%.4g s); lengthen "
+                "acoustics.rir_length_s beyond %.4g s or bring the sources closer",
+                nearest, travel_s, scene.acoustics.speed_of_sound, scene.acoustics.rir_length_s,
+                travel_s);
+  throw Error(origin + buf);
 }
 
 }  // namespace neraf::sim

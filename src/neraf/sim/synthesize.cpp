@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <filesystem>
 #include <memory>
@@ -232,9 +233,19 @@ SynthSummary write_dataset(const Scene& scene, const SynthOptions& options, cons
   sum.peak = peaks.empty() ? 0.0 : *std::max_element(peaks.begin(), peaks.end());
   if (sum.peak > 1.0) {
     const auto n_loud = std::count_if(peaks.begin(), peaks.end(), [](double p) { return p > 1.0; });
-    warn(std::to_string(n_loud) + " RIRs exceed 1.0 in amplitude (peak " +
-         std::to_string(sum.peak) +
-         ") and will be clipped by NeRAF-style loaders; move sources away from the microphones");
+    char peak[32];
+    std::snprintf(peak, sizeof peak, "%.4g", sum.peak);
+    warn(std::to_string(n_loud) + " RIRs exceed 1.0 in amplitude (peak " + peak +
+         ") and will be clipped by NeRAF-style loaders; " +
+         (options.gain > 0 ? "the gain of --gain-from (" + std::to_string(options.gain) +
+                                 ") is too large for this scene"
+                           : std::string("move sources away from the microphones")));
+  }
+  const auto n_silent = std::count(peaks.begin(), peaks.end(), 0.0);
+  if (n_silent > 0) {
+    warn(std::to_string(n_silent) + " of " + std::to_string(peaks.size()) +
+         " RIRs are all zeros (the sound does not reach those microphones within "
+         "acoustics.rir_length_s, or every path is blocked); neraf info lists them");
   }
   sum.rir_seconds = seconds_since(t_rirs);
 
@@ -290,6 +301,7 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
   validate_scene(scene, "scene \"" + scene.name + "\"");
   check_synthesis_size(scene, options.layout, "scene \"" + scene.name + "\"");
   const SynthPlan plan = plan_synthesis(scene, options.layout, options.seed);
+  check_sound_reaches_microphones(scene, plan, "scene \"" + scene.name + "\"");
   check_out_dir(options.out_dir, options.force);
   // A failure (bad HRTF, full disk, Ctrl-C) leaves no half-written dataset behind.
   SynthSummary sum;
@@ -305,16 +317,20 @@ SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
 std::optional<double> synthesized_gain(const std::string& dataset_dir) {
   const std::string path = (fs::path(dataset_dir) / "synth_info.json").string();
   if (!fs::exists(path)) return std::nullopt;
-  const double gain = io::read_json(path).value("gain", 0.0);
-  require(gain > 0, path + ": no positive \"gain\"; synthesise that folder again");
-  return gain;
+  const json info = io::read_json(path);
+  const json gain = info.is_object() ? info.value("gain", json()) : json();
+  // synthesize never raises the level (gain = min(1, 0.5 / peak)), and a gain below 1e-12 would
+  // put every sample under float's resolution of the 0.5 peak.
+  require(gain.is_number() && gain.get<double>() >= 1e-12 && gain.get<double>() <= 1,
+          path +
+              ": \"gain\" must be a number in [1e-12, 1], as neraf synth writes it; "
+              "synthesise that folder again");
+  return gain.get<double>();
 }
 
-std::optional<std::string> room_difference(const std::string& dataset_a,
-                                           const std::string& dataset_b) {
-  const fs::path a = fs::path(dataset_a) / "scene.json", b = fs::path(dataset_b) / "scene.json";
-  if (!fs::exists(a) || !fs::exists(b)) return std::nullopt;
-  json room_a = io::read_json(a.string()), room_b = io::read_json(b.string());
+namespace {
+
+std::optional<std::string> scene_json_difference(json room_a, json room_b) {
   if (!room_a.is_object() || !room_b.is_object()) return std::nullopt;  // not ours to judge
   for (json* room : {&room_a, &room_b})
     for (const char* placement : {"name", "microphones", "sources", "cameras"})
@@ -324,6 +340,21 @@ std::optional<std::string> room_difference(const std::string& dataset_a,
   for (const auto& [key, value] : room_b.items())
     if (!room_a.contains(key)) return key;
   return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<std::string> room_difference(const std::string& dataset_a,
+                                           const std::string& dataset_b) {
+  const fs::path a = fs::path(dataset_a) / "scene.json", b = fs::path(dataset_b) / "scene.json";
+  if (!fs::exists(a) || !fs::exists(b)) return std::nullopt;
+  return scene_json_difference(io::read_json(a.string()), io::read_json(b.string()));
+}
+
+std::optional<std::string> room_difference(const Scene& scene, const std::string& dataset) {
+  const fs::path b = fs::path(dataset) / "scene.json";
+  if (!fs::exists(b)) return std::nullopt;
+  return scene_json_difference(scene_to_json(scene), io::read_json(b.string()));
 }
 
 }  // namespace neraf::sim

@@ -81,6 +81,12 @@ constexpr double kMaxSynthBytes = 64e9;
 void check_synthesis_size(const Scene& scene, const std::string& layout, const std::string& origin,
                           const std::string& count_flags = "");
 
+// Throws neraf::Error (naming `origin` and acoustics.rir_length_s) when no RIR of the plan could
+// hold a sound: every source-microphone pair is farther apart than the sound travels within
+// rir_length_s, so every RIR would be all zeros (the direct path arrives first).
+void check_sound_reaches_microphones(const Scene& scene, const SynthPlan& plan,
+                                     const std::string& origin);
+
 struct SynthSummary {
   std::string layout, out_dir;
   int sample_rate = 0, channels = 0;
@@ -108,5 +114,7 @@ std::optional<double> synthesized_gain(const std::string& dataset_dir);
 // "materials", ...); none when the rooms match or a folder has no scene.json (e.g. real data).
 std::optional<std::string> room_difference(const std::string& dataset_a,
                                            const std::string& dataset_b);
+// The same for a scene and a `neraf synth` folder.
+std::optional<std::string> room_difference(const Scene& scene, const std::string& dataset);
 
 }  // namespace neraf::sim

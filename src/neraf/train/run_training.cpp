@@ -52,6 +52,18 @@ std::optional<std::string> newest_intact_checkpoint(const std::string& run_dir) 
   return std::nullopt;
 }
 
+// On resume, the pictures must be those the run was trained on (`was`: its data.json entry).
+void check_resumed_images(const nlohmann::json& was, const nlohmann::json& now,
+                          const std::string& data_dir) {
+  for (const std::string key :
+       {"num_train", "height", "width", "train_files", "train_pixels_fnv1a"}) {
+    if (key == "train_pixels_fnv1a" && !was.contains(key)) continue;  // a run from before the hash
+    require(was.value(key, nlohmann::json()) == now[key],
+            data_dir + ": differs from the dataset this run was trained on (" + key +
+                "); resume with the original --data");
+  }
+}
+
 // The calibration stage (infer/calibration.h) of a finished audio/joint run, unless done.
 void calibrate_if_needed(const TrainConfig& cfg, const std::string& run_dir,
                          const std::string& checkpoint, int64_t step,
@@ -144,10 +156,7 @@ std::vector<SceneData> load_scenes(TrainConfig& cfg, const TrainRunOptions& opti
               "--data: this run was trained on " + std::to_string(old["scenes"].size()) +
                   " scenes; resume with its own --data folders");
       const nlohmann::json& was = old["scenes"][s];
-      for (const char* key : {"num_train", "height", "width", "train_files"})
-        require(was.value(key, nlohmann::json()) == sc.manifest[key],
-                sc.data_dir + ": differs from the dataset this run was trained on (" + key +
-                    "); resume with the original --data");
+      check_resumed_images(was, sc.manifest, sc.data_dir);
       if (was.contains("audio")) infer::check_audio_manifest(was["audio"], *sc.rirs, sc.data_dir);
     }
     sc.manifest["audio"] = infer::make_audio_manifest(*sc.rirs);
@@ -305,10 +314,7 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
     if (cfg.modality == Modality::audio)
       infer::check_vision_run_data(cfg.audio.vision_run, manifest);  // not another room's field
     if (!old_manifest.is_null() && resume_from) {
-      for (const char* key : {"num_train", "height", "width", "train_files"})
-        require(old_manifest.value(key, nlohmann::json()) == manifest[key],
-                data_dir + ": differs from the dataset this run was trained on (" + key +
-                    "); resume with the original --data");
+      check_resumed_images(old_manifest, manifest, data_dir);
     }
     // The acoustic branch's RIRs (features cached next to the dataset) and their manifest.
     if (cfg.modality != Modality::vision) {

@@ -31,9 +31,15 @@ nlohmann::json parse_json(const std::string& text, const std::string& path,
     return value;
   } catch (const nlohmann::json::parse_error& e) {
     throw Error(path + ": not valid JSON (at byte " + std::to_string(e.byte) + "); " + fix);
-  } catch (const nlohmann::json::exception& e) {  // e.g. out_of_range: a number beyond a double
-    throw Error(path + ": not valid JSON (" + e.what() + "); " + fix);
+  } catch (const nlohmann::json::out_of_range&) {  // the parser's only one: number overflow
+    throw Error(path + ": a number in it is too large for a double (beyond ±1.8e308); " + fix);
+  } catch (const nlohmann::json::exception&) {
+    throw Error(path + ": not valid JSON; " + fix);
   }
+}
+
+std::string json_quoted(const std::string& text) {
+  return nlohmann::json(text).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace neraf

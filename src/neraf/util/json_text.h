@@ -10,4 +10,8 @@ namespace neraf {
 nlohmann::json parse_json(const std::string& text, const std::string& path,
                           const std::string& fix = "fix or regenerate the file");
 
+// `text` in double quotes with JSON escapes ("a\u0000b"), for quoting a key or string of a user's
+// file in a message: a NUL or newline in it would otherwise cut or split the one-line error.
+std::string json_quoted(const std::string& text);
+
 }  // namespace neraf
