@@ -239,6 +239,72 @@ TEST(BadData, PngCutInHalf) {
   EXPECT_NE(training_error(img.path()).find("eval_0000.png"), std::string::npos);
 }
 
+// Probe round of 2026-12-04, F22: an index past the range of long (strtol clamped it to
+// LONG_MAX) and a fifth column on every row (ignored) were accepted without a word.
+TEST(BadData, PointsTxtIndexOutOfRangeOrExtraColumn) {
+  SoundSpaces big;
+  testing::write_text(big.dir / "metadata/points.txt",
+                      "0\t1.0\t1.5\t2.0\n99999999999999999999\t-0.5\t1.5\t0.25\n"
+                      "2\t2.5\t1.2\t-1.0\n3\t0.0\t1.8\t3.0\n");
+  expect_rejected(big.dir.path(), "metadata/points.txt",
+                  "line 2: point index 99999999999999999999 is out of range");
+
+  SoundSpaces wide;
+  std::string pts;
+  for (size_t i = 0; i < wide.scene.points.size(); ++i) {
+    const auto& p = wide.scene.points[i];
+    pts += std::to_string(i) + "\t" + std::to_string(p[0]) + "\t" + std::to_string(p[1]) + "\t" +
+           std::to_string(p[2]) + "\t7\n";
+  }
+  testing::write_text(wide.dir / "metadata/points.txt", pts);
+  expect_rejected(wide.dir.path(), "metadata/points.txt", "line 1: more than 4 columns");
+  const std::string all = all_text(validate_dataset(wide.dir.path()));
+  EXPECT_NE(all.find("line 4: more than 4 columns"), std::string::npos) << all;
+}
+
+// A split entry names its wav file: "0/00_1" would be a second entry of 0/0_1.wav (the loader
+// builds the name from the numbers), so entries must be written as their numbers print.
+TEST(BadData, SoundSpacesSplitEntryWrittenAnotherWay) {
+  SoundSpaces ss;
+  testing::write_text(ss.dir / "metadata_AudioNeRF/split.json",
+                      R"({"train": ["0/0_1", "90/1_2", "0/00_1"], "test": ["180/1_0"]})");
+  expect_rejected(ss.dir.path(), "split.json",
+                  "train[2] \"0/00_1\" is not \"<rot>/<receiver>_<source>\"");
+}
+
+// F22: a source quaternion with a 90° roll was reduced to its yaw without a word. The published
+// code uses the yaw alone, so the data stays usable; info and training warn, naming the file.
+TEST(BadData, TiltedRafSourceIsAWarning) {
+  Raf raf;
+  const auto& e = raf.room.entries[2];
+  // R = Rz(90°)·Ry(30°): a loudspeaker on its side, facing 30°.
+  const geometry::Quaternion q = geometry::multiply(geometry::axis_angle(0, 0, 1, M_PI / 2),
+                                                    geometry::axis_angle(0, 1, 0, 30 * M_PI / 180));
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", q.x, q.y, q.z, q.w,
+                e.tx[0], e.tx[1], e.tx[2]);
+  testing::write_text(raf.dir / "data/000002/tx_pos.txt", buf);
+  expect_warned(raf.dir.path(), "data/000002/tx_pos.txt", "tilted 90°");
+  RirLoadOptions o;
+  o.progress = false;
+  o.load_features = false;
+  EXPECT_NEAR(load_rir_set(raf.dir.path(), o).rirs[2].raw_yaw_deg, 30.0, 1e-9);
+}
+
+// w / h are whole pixels: 1e300 does not fit an int (undefined behaviour before), 12.5 is no size.
+TEST(BadData, ImageSizeThatIsNoSize) {
+  for (const char* w : {"1e300", "12.5", "-12"}) {
+    TempDir img;
+    NerfstudioScene scene;
+    scene.write(img.path());
+    std::string text = scene.json_text();
+    const std::string width = "\"w\": 12";
+    text.replace(text.find(width), width.size(), std::string("\"w\": ") + w);
+    testing::write_text(img / "transforms.json", text);
+    expect_rejected(img.path(), "transforms.json", "\"w\" is not a whole number of pixels");
+  }
+}
+
 bool cache_folder_has_files(const std::string& dir) {
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(fs::path(dir) / ".neraf_cache", ec)) {

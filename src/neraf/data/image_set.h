@@ -9,15 +9,9 @@
 #include <vector>
 
 #include "neraf/data/problem.h"
+#include "neraf/data/transforms_json.h"  // Intrinsics
 
 namespace neraf::data {
-
-struct Intrinsics {  // OPENCV camera model, pixels
-  double fx = 0, fy = 0, cx = 0, cy = 0;
-  int width = 0, height = 0;
-  double k1 = 0, k2 = 0, p1 = 0, p2 = 0;  // distortion (zero for the simulator)
-  double k3 = 0;  // third radial coefficient (nerfstudio OPENCV also carries it; usually 0)
-};
 
 struct ImageSplit {
   std::vector<std::string> files;       // image paths, one per frame

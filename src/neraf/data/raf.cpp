@@ -1,18 +1,20 @@
 // RAF (Real Acoustic Fields) in the layout the published NeRAF code reads (neraf-reference.md
 // §3.3):
-//   <room>/metadata/data-split.json   {"train": [[ids]], "validation": [[...], ...], "test":
-//   [[ids]]} <room>/data/<id>/rir.wav          mono, 48 kHz <room>/data/<id>/rx_pos.txt "x,y,z"
-//   microphone (omni), m <room>/data/<id>/tx_pos.txt       "qx,qy,qz,qw,x,y,z"     source
-//   orientation (real last) + position
+//   <room>/metadata/data-split.json  {"train": [[ids]], "validation": [[...]], "test": [[ids]]}
+//   <room>/data/<id>/rir.wav         mono, 48 kHz
+//   <room>/data/<id>/rx_pos.txt      "x,y,z"              microphone (omni), m
+//   <room>/data/<id>/tx_pos.txt      "qx,qy,qz,qw,x,y,z"  source orientation (real last), position
+// The split and pose files are parsed by pose_files.h; this file checks the files they name.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
-#include <sstream>
 
 #include "neraf/data/audio_probe.h"
+#include "neraf/data/pose_files.h"
 #include "neraf/data/rir_check.h"
 #include "neraf/data/rir_layouts.h"
 #include "neraf/dsp/stft.h"
@@ -27,27 +29,8 @@ using nlohmann::json;
 namespace neraf::data::detail {
 namespace {
 
-// All numbers of a one-line text file separated by commas and/or white space. False if a token
-// is not a number.
-bool read_numbers(const std::string& path, std::vector<double>& out, std::string& text) {
-  std::ifstream in(path);
-  if (!in.good()) return false;
-  std::stringstream ss;
-  ss << in.rdbuf();
-  text = ss.str();
-  std::string t = text;
-  std::replace(t.begin(), t.end(), ',', ' ');
-  std::istringstream is(t);
-  std::string tok;
-  out.clear();
-  while (is >> tok) {
-    char* end = nullptr;
-    const double v = std::strtod(tok.c_str(), &end);
-    if (*end != '\0') return false;
-    out.push_back(v);
-  }
-  return true;
-}
+static_assert(kMaxAbsPoseCoordinate == kMaxAbsCoordinate,
+              "pose_files.h and rir_check.h bound positions alike");
 
 // Python's round(): halves go to the even neighbour (std::nearbyint in the default mode).
 int round_half_even(double v) { return static_cast<int>(std::nearbyint(v)); }
@@ -94,18 +77,8 @@ RirIndex index_raf(const std::string& dir, ProblemList& problems) {
     problems.error("", e.what(), "");
     return idx;
   }
-  auto first_list = [&](const char* name) -> const json* {
-    if (!split.is_object() || !split.contains(name) || !split[name].is_array() ||
-        split[name].empty() || !split[name][0].is_array())
-      return nullptr;
-    return &split[name][0];  // NeRAF reads ['train'][0] and ['test'][0]
-  };
-  const json* lists[2] = {first_list("train"), first_list("test")};
-  if (!lists[0] || !lists[1]) {
-    problems.error(split_path, "must hold {\"train\": [[ids]], \"test\": [[ids]]}",
-                   "use the RAF repository's data-split file of this room");
-    return idx;
-  }
+  const std::array<const json*, 2> lists = raf_split_lists(split, split_path, problems);
+  if (!lists[0]) return idx;
 
   std::set<std::string> seen;
   const char* names[2] = {"train", "test"};
@@ -113,35 +86,16 @@ RirIndex index_raf(const std::string& dir, ProblemList& problems) {
     const json& list = *lists[li];
     for (size_t k = 0; k < list.size(); ++k) {
       const std::string where = std::string(names[li]) + "[0][" + std::to_string(k) + "]";
-      std::string id;
-      if (list[k].is_string()) {
-        id = list[k].get<std::string>();
-      } else if (list[k].is_number_integer()) {
-        char buf[32];
-        std::snprintf(buf, sizeof buf, "%06lld", static_cast<long long>(list[k].get<int64_t>()));
-        id = buf;
-      } else {
-        problems.error(split_path, where + " is not an id",
-                       "ids are numbers or \"000123\" strings");
-        continue;
-      }
-      if (id.empty() || id.find('/') != std::string::npos || id == "." || id == "..") {
-        problems.error(split_path, where + " \"" + id + "\" is not an id",
-                       "ids name folders of data/ (\"000123\"), not paths");
-        continue;
-      }
+      const std::optional<std::string> given = raf_split_id(list[k], where, split_path, problems);
+      if (!given) continue;
+      std::string id = *given;
       std::string folder = (fs::path(dir) / "data" / id).string();
       if (!fs::is_directory(folder, ec) && list[k].is_string()) {
         // "123" written without the zero padding of the folder names
-        char* end = nullptr;
-        const long long v = std::strtoll(id.c_str(), &end, 10);
-        if (*end == '\0') {
-          char buf[32];
-          std::snprintf(buf, sizeof buf, "%06lld", v);
-          if (fs::is_directory(fs::path(dir) / "data" / buf, ec)) {
-            id = buf;
-            folder = (fs::path(dir) / "data" / id).string();
-          }
+        const std::optional<std::string> padded = raf_padded_id(id);
+        if (padded && fs::is_directory(fs::path(dir) / "data" / *padded, ec)) {
+          id = *padded;
+          folder = (fs::path(dir) / "data" / id).string();
         }
       }
       if (!seen.insert(id).second) {
@@ -168,41 +122,14 @@ RirIndex index_raf(const std::string& dir, ProblemList& problems) {
                        "restore the file or remove the id from " + split_path);
         continue;
       }
-      std::vector<double> rx, tx;
-      std::string text;
       const std::string rx_path = (fs::path(folder) / "rx_pos.txt").string();
       const std::string tx_path = (fs::path(folder) / "tx_pos.txt").string();
-      if (!read_numbers(rx_path, rx, text) || rx.size() != 3) {
-        problems.error(rx_path, "missing or not \"x,y,z\"",
-                       "restore the file from the RAF release");
-        continue;
-      }
-      if (!read_numbers(tx_path, tx, text) || tx.size() != 7) {
-        problems.error(tx_path, "missing or not \"qx,qy,qz,qw,x,y,z\"",
-                       "restore the file from the RAF release");
-        continue;
-      }
-      if (!sane_coordinates(rx.data(), 3)) {
-        problems.error(rx_path,
-                       "microphone position has a NaN, infinite or implausible coordinate "
-                       "(|x| > 10000 m)",
-                       "fix the file (metres) or remove the id from the split");
-        continue;
-      }
-      // The quaternion's scale does not matter (it is normalised), but 1e300 components overflow.
-      const double qn = std::sqrt(tx[0] * tx[0] + tx[1] * tx[1] + tx[2] * tx[2] + tx[3] * tx[3]);
-      if (!sane_coordinates(tx.data(), 7) || !(qn > 1e-9)) {
-        problems.error(
-            tx_path,
-            "source pose has a NaN, infinite or implausible value (|x| > 10000) or a "
-            "zero quaternion",
-            "fix the file (qx,qy,qz,qw,x,y,z in metres) or remove the id from the split");
-        continue;
-      }
-      rir.mic = {rx[0], rx[1], rx[2]};
-      rir.source = {tx[4], tx[5], tx[6]};
-      // Omni microphones: the orientation is the SOURCE yaw, scipy 'yxz' Euler angle about y.
-      rir.raw_yaw_deg = geometry::yaw_yxz_deg({tx[0], tx[1], tx[2], tx[3]});
+      const std::optional<RafPose> pose = parse_raf_pose(
+          read_file_text(rx_path), rx_path, read_file_text(tx_path), tx_path, problems);
+      if (!pose) continue;
+      rir.mic = pose->mic;
+      rir.source = pose->source;
+      rir.raw_yaw_deg = pose->yaw_deg;
       rir.heading_deg = round_half_even(rir.raw_yaw_deg);
       rir.rot = encode_heading(rir.heading_deg);
       (li == 0 ? set.train : set.test).push_back(set.size());

@@ -1,18 +1,18 @@
 // SoundSpaces 1.0 (Replica) in the layout the published NeRAF code reads (neraf-reference.md §3.2):
-//   <scene>/metadata/points.txt                          idx \t x \t y \t z  (Habitat, y up)
-//   <scene>/metadata_AudioNeRF/split.json                {"train": ["<rot>/<r>_<s>", ...], "test":
-//   [...]} <scene>/binaural_rirs/<rot>/<r>_<s>.wav              44.1 kHz, 2 channels
+//   <scene>/metadata/points.txt              idx \t x \t y \t z  (Habitat, y up)
+//   <scene>/metadata_AudioNeRF/split.json    {"train": ["<rot>/<r>_<s>", ...], "test": [...]}
+//   <scene>/binaural_rirs/<rot>/<r>_<s>.wav  44.1 kHz, 2 channels
 //   <scene>/binaural_magnitudes_sr22050/<rot>/<r>_<s>.npy  optional [2, 257, T] magnitudes
+// points.txt and split.json are parsed by pose_files.h; this file checks the files they name.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <set>
-#include <sstream>
+#include <optional>
 
 #include "neraf/data/audio_probe.h"
+#include "neraf/data/pose_files.h"
 #include "neraf/data/rir_check.h"
 #include "neraf/data/rir_layouts.h"
 #include "neraf/dsp/resample.h"
@@ -29,27 +29,6 @@ namespace neraf::data::detail {
 namespace {
 
 std::string join(const std::string& a, const std::string& b) { return (fs::path(a) / b).string(); }
-
-// "<rot>/<r>_<s>" -> rot, r, s. False when malformed.
-bool parse_entry(const std::string& e, int& rot, long& r, long& s) {
-  const size_t slash = e.find('/');
-  if (slash == std::string::npos) return false;
-  const size_t under = e.find('_', slash + 1);
-  if (under == std::string::npos) return false;
-  auto to_long = [](const std::string& t, long& v) {
-    if (t.empty()) return false;
-    char* end = nullptr;
-    errno = 0;
-    v = std::strtol(t.c_str(), &end, 10);
-    return errno == 0 && *end == '\0';
-  };
-  long rl = 0;
-  if (!to_long(e.substr(0, slash), rl) || !to_long(e.substr(slash + 1, under - slash - 1), r) ||
-      !to_long(e.substr(under + 1), s))
-    return false;
-  rot = static_cast<int>(rl);
-  return true;
-}
 
 std::vector<float> clipped(std::vector<float> x) {
   for (float& v : x) v = std::clamp(v, -1.0f, 1.0f);
@@ -88,58 +67,14 @@ RirIndex index_soundspaces(const std::string& dir, bool use_magnitude_files,
 
   // Points: idx -> [x, z, -y] (Habitat y-up to the frame NeRAF uses; no height offset).
   const std::string points_path = join(dir, "metadata/points.txt");
-  std::map<long, geometry::Vec3> points;
-  {
-    std::ifstream in(points_path);
-    if (!in.good()) {
-      problems.error(points_path, "missing or unreadable",
-                     "copy metadata/points.txt from the SoundSpaces 1.0 release of this scene");
-      return idx;
-    }
-    std::string line;
-    int line_no = 0;
-    while (std::getline(in, line)) {
-      ++line_no;
-      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-      std::istringstream ls(line);
-      std::string tok[4];
-      int n = 0;
-      while (n < 4 && ls >> tok[n]) ++n;
-      std::string extra;
-      long id = 0;
-      double v[3];
-      bool ok = n == 4;
-      if (ok) {
-        char* end = nullptr;
-        id = std::strtol(tok[0].c_str(), &end, 10);
-        ok = *end == '\0';
-        for (int k = 0; k < 3 && ok; ++k) {
-          v[k] = std::strtod(tok[k + 1].c_str(), &end);
-          ok = *end == '\0';
-        }
-      }
-      const std::string where = "line " + std::to_string(line_no);
-      if (!ok) {
-        problems.error(points_path,
-                       where + ": expected 'idx<TAB>x<TAB>y<TAB>z', got '" + line + "'",
-                       "fix the line");
-        continue;
-      }
-      if (!sane_coordinates(v, 3)) {
-        problems.error(points_path,
-                       where + ": point " + std::to_string(id) +
-                           " has a NaN, infinite or implausible coordinate (|x| > 10000 m)",
-                       "fix the coordinates (metres) or remove the point and the RIRs that use it");
-        continue;
-      }
-      if (points.count(id)) {
-        problems.error(points_path, where + ": duplicate point index " + std::to_string(id),
-                       "give every point a unique index");
-        continue;
-      }
-      points[id] = {v[0], v[2], -v[1]};
-    }
+  const std::optional<std::string> points_text = read_file_text(points_path);
+  if (!points_text) {
+    problems.error(points_path, "missing or unreadable",
+                   "copy metadata/points.txt from the SoundSpaces 1.0 release of this scene");
+    return idx;
   }
+  const std::map<long, geometry::Vec3> points =
+      parse_points_txt(*points_text, points_path, problems);
 
   // Split: metadata_AudioNeRF/split.json (the code's path); the repo ships it at the scene root.
   std::string split_path = join(dir, "metadata_AudioNeRF/split.json");
@@ -164,79 +99,41 @@ RirIndex index_soundspaces(const std::string& dir, bool use_magnitude_files,
     problems.error("", e.what(), "");
     return idx;
   }
-  if (!split.is_object() || !split.contains("train") || !split["train"].is_array() ||
-      !split.contains("test") || !split["test"].is_array()) {
-    problems.error(split_path, "must be {\"train\": [...], \"test\": [...]}",
-                   "use the split.json of the NeRAF repository");
-    return idx;
-  }
-
-  std::set<std::string> seen;
   int64_t npy_found = 0;
-  for (const char* name : {"train", "test"}) {
-    const json& list = split[name];
-    for (size_t k = 0; k < list.size(); ++k) {
-      const std::string where = std::string(name) + "[" + std::to_string(k) + "]";
-      if (!list[k].is_string()) {
-        problems.error(split_path, where + " is not a string", "entries look like \"270/122_44\"");
-        continue;
-      }
-      const std::string entry = list[k].get<std::string>();
-      int rot = 0;
-      long r = 0, s = 0;
-      if (!parse_entry(entry, rot, r, s)) {
-        problems.error(split_path,
-                       where + " \"" + entry + "\" is not \"<rot>/<receiver>_<source>\"",
-                       "entries look like \"270/122_44\"");
-        continue;
-      }
-      if (!seen.insert(entry).second) {
-        problems.error(split_path, where + " \"" + entry + "\" is listed twice (duplicate id)",
-                       "remove the duplicate entry");
-        continue;
-      }
-      const auto pr = points.find(r), ps = points.find(s);
-      if (pr == points.end() || ps == points.end()) {
-        problems.error(split_path,
-                       where + " \"" + entry + "\" uses point " +
-                           std::to_string(pr == points.end() ? r : s) +
-                           ", which metadata/points.txt does not define",
-                       "use the points.txt and split.json of the same scene");
-        continue;
-      }
-      Rir rir;
-      rir.id = entry;
-      const std::string stem =
-          std::to_string(rot) + "/" + std::to_string(r) + "_" + std::to_string(s);
-      rir.wav_path = join(dir, "binaural_rirs/" + stem + ".wav");
-      const std::string npy = join(dir, "binaural_magnitudes_sr22050/" + stem + ".npy");
-      rir.mic = pr->second;
-      rir.source = ps->second;
-      rir.heading_deg = rot;
-      rir.raw_yaw_deg = rot;
-      rir.rot = encode_heading(rot);
-      const FileStamp w = stamp(rir.wav_path);
-      if (w.not_regular) {
-        problems.error(rir.wav_path, "is not a regular file (a device, a pipe or a folder?)",
-                       "replace it with the RIR's wav file");
-        continue;
-      }
-      if (!w.exists) {
-        problems.error(rir.wav_path, "split entry " + where + " \"" + entry + "\" has no file",
-                       "restore the wav or remove the entry from " + split_path);
-        continue;
-      }
-      const FileStamp m = use_magnitude_files ? stamp(npy) : FileStamp{};
-      if (m.exists) {
-        ++npy_found;
-        rir.magnitude_path = npy;
-      }
-      (std::string(name) == "train" ? set.train : set.test).push_back(set.size());
-      set.rirs.push_back(std::move(rir));
-      idx.wav.push_back(w);
-      idx.npy.push_back(m);
-    }
-  }
+  const bool lists =
+      parse_soundspaces_split(split, split_path, points, problems, [&](const SoundSpacesEntry& e) {
+        Rir rir;
+        rir.id = e.id;
+        // The entry is written as its numbers print (parse_soundspaces_split): it names the files.
+        rir.wav_path = join(dir, "binaural_rirs/" + e.id + ".wav");
+        const std::string npy = join(dir, "binaural_magnitudes_sr22050/" + e.id + ".npy");
+        rir.mic = e.mic;
+        rir.source = e.source_position;
+        rir.heading_deg = e.rot;
+        rir.raw_yaw_deg = e.rot;
+        rir.rot = encode_heading(e.rot);
+        const FileStamp w = stamp(rir.wav_path);
+        if (w.not_regular) {
+          problems.error(rir.wav_path, "is not a regular file (a device, a pipe or a folder?)",
+                         "replace it with the RIR's wav file");
+          return;
+        }
+        if (!w.exists) {
+          problems.error(rir.wav_path, "split entry " + e.where + " \"" + e.id + "\" has no file",
+                         "restore the wav or remove the entry from " + split_path);
+          return;
+        }
+        const FileStamp m = use_magnitude_files ? stamp(npy) : FileStamp{};
+        if (m.exists) {
+          ++npy_found;
+          rir.magnitude_path = npy;
+        }
+        (e.train ? set.train : set.test).push_back(set.size());
+        set.rirs.push_back(std::move(rir));
+        idx.wav.push_back(w);
+        idx.npy.push_back(m);
+      });
+  if (!lists) return idx;
   const int64_t n = set.size();
   idx.use_npy = use_magnitude_files && n > 0 && npy_found == n;
   if (npy_found > 0 && npy_found < n) {

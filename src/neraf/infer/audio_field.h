@@ -16,19 +16,9 @@
 #include "neraf/data/rir_set.h"
 #include "neraf/dsp/stft.h"
 #include "neraf/geometry/vec.h"
+#include "neraf/infer/run_manifest.h"  // AudioRunInfo
 
 namespace neraf::infer {
-
-struct AudioRunInfo {
-  data::AudioLayout layout = data::AudioLayout::soundspaces;
-  int sample_rate = 22050;  // 22050 SoundSpaces, 48000 RAF
-  dsp::StftParams stft;     // soundspaces() / raf()
-  int64_t n_freq = 257;
-  int64_t max_len = 78;         // frames per RIR (T)
-  int channels = 2;             // C
-  int64_t waveform_length = 0;  // GT eval waveform length (SoundSpaces max_len·hop, RAF 15360)
-  data::Aabb aabb;              // train audio aabb (positions are normalised with it)
-};
 
 class AudioField {
  public:

@@ -48,10 +48,6 @@ std::string dataset_hash(const data::RirSet& r) {
 
 nlohmann::json vec_json(const geometry::Vec3& v) { return {v.x, v.y, v.z}; }
 
-geometry::Vec3 vec_from(const nlohmann::json& j) {
-  return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
-}
-
 }  // namespace
 
 nlohmann::json make_audio_manifest(const data::RirSet& r) {
@@ -73,57 +69,6 @@ nlohmann::json make_audio_manifest(const data::RirSet& r) {
   if (!r.max_len_source.empty()) m["max_len_source"] = r.max_len_source;
   if (!r.max_len_note.empty()) m["max_len_note"] = r.max_len_note;
   return m;
-}
-
-AudioRunInfo audio_info_from_manifest(const nlohmann::json& a, const std::string& where) {
-  try {
-    AudioRunInfo info;
-    const std::string layout = a.at("layout").get<std::string>();
-    require(layout == "soundspaces" || layout == "raf", where + ": unknown audio layout");
-    info.layout = layout == "raf" ? data::AudioLayout::raf : data::AudioLayout::soundspaces;
-    info.sample_rate = a.at("sample_rate").get<int>();
-    info.channels = a.at("channels").get<int>();
-    info.stft.n_fft = a.at("n_fft").get<int>();
-    info.stft.win_length = a.at("win_length").get<int>();
-    info.stft.hop_length = a.at("hop_length").get<int>();
-    info.stft.center = true;
-    info.n_freq = a.at("n_freq").get<int64_t>();
-    info.max_len = a.at("max_len").get<int64_t>();
-    info.waveform_length = a.at("waveform_length").get<int64_t>();
-    info.aabb.min = vec_from(a.at("aabb_min"));
-    info.aabb.max = vec_from(a.at("aabb_max"));
-    // Every later failure (STFT sizes, a WAV at 0 Hz, a box inside out) would otherwise blame a
-    // flag or an output file.
-    auto check = [&](bool ok, const std::string& key, const nlohmann::json& value,
-                     const std::string& rule) {
-      require(ok, where + ": is damaged (audio." + key + " is " + value.dump() + "; " + rule +
-                      "); restore it or re-run neraf train");
-    };
-    const dsp::StftParams& s = info.stft;
-    check(info.sample_rate >= 1 && info.sample_rate <= 768000, "sample_rate", a["sample_rate"],
-          "expected 1..768000 Hz");
-    check(info.channels >= 1 && info.channels <= 64, "channels", a["channels"], "expected 1..64");
-    check(info.layout != data::AudioLayout::raf || info.channels == 1, "channels", a["channels"],
-          "the raf layout is mono");
-    check(s.n_fft >= 2 && s.n_fft <= (1 << 20), "n_fft", a["n_fft"], "expected 2..1048576");
-    check(s.win_length >= 1 && s.win_length <= s.n_fft, "win_length", a["win_length"],
-          "expected 1..n_fft");
-    check(s.hop_length >= 1 && s.hop_length <= s.win_length, "hop_length", a["hop_length"],
-          "expected 1..win_length");
-    check(info.n_freq == s.n_fft / 2 + 1, "n_freq", a["n_freq"], "expected n_fft / 2 + 1");
-    check(info.max_len >= 2 && info.max_len <= 100000, "max_len", a["max_len"],
-          "expected 2..100000 frames");
-    check(info.waveform_length >= 1, "waveform_length", a["waveform_length"],
-          "expected a positive sample count");
-    const geometry::Vec3 &lo = info.aabb.min, &hi = info.aabb.max;
-    for (double v : {lo.x, lo.y, lo.z, hi.x, hi.y, hi.z})
-      check(std::isfinite(v), "aabb_min/aabb_max", a["aabb_min"], "expected finite metres");
-    check(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z, "aabb_min", a["aabb_min"],
-          "expected at most aabb_max " + a["aabb_max"].dump() + " on every axis");
-    return info;
-  } catch (const nlohmann::json::exception&) {
-    throw Error(where + ": the audio manifest is incomplete; re-run neraf train");
-  }
 }
 
 void check_audio_manifest(const nlohmann::json& manifest, const data::RirSet& rirs,

@@ -43,9 +43,9 @@
 namespace neraf::infer {
 
 // The "audio" entry of RUN/data.json (layout, counts, a hash of the RIR ids/poses, STFT sizes,
-// aabb) and its inverse. Loading a run or resuming checks it against the dataset.
+// aabb); its inverse is audio_info_from_manifest (run_manifest.h). Loading a run or resuming
+// checks it against the dataset.
 nlohmann::json make_audio_manifest(const data::RirSet& rirs);
-AudioRunInfo audio_info_from_manifest(const nlohmann::json& audio, const std::string& where);
 // neraf::Error "<where>: ... differs (key)" when `rirs` is not the dataset of `manifest`.
 void check_audio_manifest(const nlohmann::json& manifest, const data::RirSet& rirs,
                           const std::string& where);
