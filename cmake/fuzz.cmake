@@ -34,8 +34,23 @@ file(GLOB neraf_fuzz_sim_srcs CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/src
 add_library(neraf_fuzz_sim STATIC ${neraf_fuzz_sim_srcs})
 target_link_libraries(neraf_fuzz_sim PUBLIC neraf_io neraf_dsp neraf_geometry)
 
+# The data stage is a LibTorch library too, but its parsers of pose, split and transforms.json
+# files live in torch-free files of their own (data/pose_files.h, data/transforms_json.h): compiled
+# here for the fuzzers alone, as the simulator is.
+set(neraf_fuzz_src "${CMAKE_CURRENT_SOURCE_DIR}/src/neraf")
+add_library(neraf_fuzz_data STATIC "${neraf_fuzz_src}/data/problem.cpp"
+                                   "${neraf_fuzz_src}/data/pose_files.cpp"
+                                   "${neraf_fuzz_src}/data/transforms_json.cpp")
+target_link_libraries(neraf_fuzz_data PUBLIC neraf_io neraf_geometry)
+# Likewise the run manifests: RUN/config.json (train_config_json.cpp, with the radiance field's
+# config tables of nerf/config.cpp) and what is read back from RUN/data.json (run_manifest.cpp).
+add_library(neraf_fuzz_infer STATIC "${neraf_fuzz_src}/infer/run_manifest.cpp"
+                                    "${neraf_fuzz_src}/infer/train_config_json.cpp"
+                                    "${neraf_fuzz_src}/nerf/config.cpp")
+target_link_libraries(neraf_fuzz_infer PUBLIC neraf_fuzz_data)
+
 foreach(lib neraf_util neraf_io neraf_dsp neraf_metrics neraf_geometry neraf_model_file
-            neraf_rt_objects neraf_fuzz_sim)
+            neraf_rt_objects neraf_fuzz_sim neraf_fuzz_data neraf_fuzz_infer)
   target_compile_options(${lib} PRIVATE ${NERAF_FUZZ_LIB_FLAGS})
 endforeach()
 # The shared neraf_rt links its (now instrumented) objects with --no-undefined and no sanitizer
@@ -53,6 +68,13 @@ set(neraf_fuzz_libs_model_file neraf_model_file)
 set(neraf_fuzz_libs_model_payload neraf_model_file)
 set(neraf_fuzz_libs_c_api neraf_rt_static)
 set(neraf_fuzz_libs_scene_json neraf_fuzz_sim)
+set(neraf_fuzz_libs_transforms_json neraf_fuzz_data)
+set(neraf_fuzz_libs_points_txt neraf_fuzz_data)
+set(neraf_fuzz_libs_soundspaces_split neraf_fuzz_data)
+set(neraf_fuzz_libs_raf_split neraf_fuzz_data)
+set(neraf_fuzz_libs_raf_poses neraf_fuzz_data)
+set(neraf_fuzz_libs_run_config neraf_fuzz_infer)
+set(neraf_fuzz_libs_data_manifest neraf_fuzz_infer)
 
 add_custom_target(neraf_fuzz)
 file(GLOB neraf_fuzz_srcs CONFIGURE_DEPENDS "${CMAKE_CURRENT_SOURCE_DIR}/fuzz/fuzz_*.cpp")
