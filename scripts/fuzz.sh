@@ -8,7 +8,10 @@
 #   scripts/fuzz.sh 30           30 s each
 #   scripts/fuzz.sh 30 npy c_api only these targets (names as in fuzz/fuzz_<name>.cpp)
 # Environment: CC/CXX pick the compiler (default: the newest clang-16/15/14, else clang),
-# NERAF_FUZZ_JOBS the build's parallelism (default 2, as scripts/build.sh).
+# NERAF_FUZZ_JOBS the build's parallelism (default 2, as scripts/build.sh), NERAF_FUZZ_PARALLEL
+# how many targets run at once (default 1; on a many-core machine, e.g. 16, every target gets a
+# core), NERAF_FUZZ_PREBUILT=1 runs the targets already in build-fuzz/fuzz without building (a
+# machine without clang running another's build).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
@@ -19,59 +22,61 @@ if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [ "$seconds" -eq 0 ]; then
 fi
 build="build-fuzz"
 
-SUDO=""
-[ "$(id -u)" -eq 0 ] || SUDO="sudo"
-apt_install() {
-  echo "fuzz: installing $*"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "$@"
-}
+if [ "${NERAF_FUZZ_PREBUILT:-0}" != 1 ]; then
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  apt_install() {
+    echo "fuzz: installing $*"
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "$@"
+  }
 
-# ---- compiler: clang with libFuzzer's and the sanitizers' runtimes, and its OpenMP --------------
-pick_clang() {
-  if [ -n "${CXX:-}" ]; then
-    echo "${CC:-${CXX/clang++/clang}} $CXX"
-    return
-  fi
-  for v in 16 15 14; do
-    if command -v "clang++-$v" >/dev/null 2>&1; then
-      echo "clang-$v clang++-$v"
+  # ---- compiler: clang with libFuzzer's and the sanitizers' runtimes, and its OpenMP --------------
+  pick_clang() {
+    if [ -n "${CXX:-}" ]; then
+      echo "${CC:-${CXX/clang++/clang}} $CXX"
       return
     fi
-  done
-  command -v clang++ >/dev/null 2>&1 && echo "clang clang++"
-}
-# Whether $1 links a libFuzzer target with ASan/UBSan and OpenMP (the runtimes are separate Debian
-# packages from the compiler).
-can_fuzz() {
-  local probe
-  probe=$(mktemp -d)
-  printf '%s\n' '#include <cstddef>' '#include <cstdint>' \
-    'extern "C" int LLVMFuzzerTestOneInput(const uint8_t*, size_t) { return 0; }' >"$probe/p.cpp"
-  "$1" -fsanitize=fuzzer,address,undefined -fopenmp "$probe/p.cpp" -o "$probe/p" >/dev/null 2>&1
-  local ok=$?
-  rm -rf "$probe"
-  return $ok
-}
-read -r cc cxx <<<"$(pick_clang || true)"
-if [ -z "${cxx:-}" ]; then
-  apt_install clang libclang-rt-dev libomp-dev  # Debian 12: clang 14
-  read -r cc cxx <<<"$(pick_clang)"
-fi
-if ! can_fuzz "$cxx"; then
-  ver=$("$cxx" -dumpversion | cut -d. -f1)
-  apt_install "libclang-rt-$ver-dev" "libomp-$ver-dev"
-  can_fuzz "$cxx" || { echo "fuzz: $cxx cannot link a libFuzzer target" >&2; exit 2; }
-fi
+    for v in 16 15 14; do
+      if command -v "clang++-$v" >/dev/null 2>&1; then
+        echo "clang-$v clang++-$v"
+        return
+      fi
+    done
+    command -v clang++ >/dev/null 2>&1 && echo "clang clang++"
+  }
+  # Whether $1 links a libFuzzer target with ASan/UBSan and OpenMP (the runtimes are separate Debian
+  # packages from the compiler).
+  can_fuzz() {
+    local probe
+    probe=$(mktemp -d)
+    printf '%s\n' '#include <cstddef>' '#include <cstdint>' \
+      'extern "C" int LLVMFuzzerTestOneInput(const uint8_t*, size_t) { return 0; }' >"$probe/p.cpp"
+    "$1" -fsanitize=fuzzer,address,undefined -fopenmp "$probe/p.cpp" -o "$probe/p" >/dev/null 2>&1
+    local ok=$?
+    rm -rf "$probe"
+    return $ok
+  }
+  read -r cc cxx <<<"$(pick_clang || true)"
+  if [ -z "${cxx:-}" ]; then
+    apt_install clang libclang-rt-dev libomp-dev  # Debian 12: clang 14
+    read -r cc cxx <<<"$(pick_clang)"
+  fi
+  if ! can_fuzz "$cxx"; then
+    ver=$("$cxx" -dumpversion | cut -d. -f1)
+    apt_install "libclang-rt-$ver-dev" "libomp-$ver-dev"
+    can_fuzz "$cxx" || { echo "fuzz: $cxx cannot link a libFuzzer target" >&2; exit 2; }
+  fi
 
-# ---- build -------------------------------------------------------------------------------------
-generator=()
-command -v ninja >/dev/null 2>&1 && generator=(-G Ninja)
-[ -f "$build/CMakeCache.txt" ] || generator_args=("${generator[@]}")
-cmake -S . -B "$build" "${generator_args[@]+"${generator_args[@]}"}" -DNERAF_FUZZ=ON \
-  -DNERAF_WITH_TORCH=OFF -DNERAF_TESTS=OFF -DNERAF_BENCH=OFF -DNERAF_NATIVE=OFF \
-  -DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_COMPILER="$cc" -DCMAKE_CXX_COMPILER="$cxx" >/dev/null
-cmake --build "$build" --target neraf_fuzz -j "${NERAF_FUZZ_JOBS:-2}"
+  # ---- build -------------------------------------------------------------------------------------
+  generator=()
+  command -v ninja >/dev/null 2>&1 && generator=(-G Ninja)
+  [ -f "$build/CMakeCache.txt" ] || generator_args=("${generator[@]}")
+  cmake -S . -B "$build" "${generator_args[@]+"${generator_args[@]}"}" -DNERAF_FUZZ=ON \
+    -DNERAF_WITH_TORCH=OFF -DNERAF_TESTS=OFF -DNERAF_BENCH=OFF -DNERAF_NATIVE=OFF \
+    -DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_COMPILER="$cc" -DCMAKE_CXX_COMPILER="$cxx" >/dev/null
+  cmake --build "$build" --target neraf_fuzz -j "${NERAF_FUZZ_JOBS:-2}"
+fi
 
 # ---- run ---------------------------------------------------------------------------------------
 targets=("$@")
@@ -97,43 +102,64 @@ export LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp:print_suppressions=0${LSAN
 export UBSAN_OPTIONS="print_stacktrace=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
 
 mkdir -p "$build/logs"
-summary=()
-failed=0
-for t in "${targets[@]}"; do
-  exe="$build/fuzz/fuzz_$t"
-  [ -x "$exe" ] || { echo "fuzz: no target '$t' ($exe)" >&2; exit 2; }
-  corpus="$build/corpus/$t"
-  findings="$build/findings/$t"
-  log="$build/logs/$t.log"
+# One target: fuzzes it and writes its summary line to $build/logs/<target>.summary; fails when it
+# found something.
+run_target() {
+  local t=$1
+  local exe="$build/fuzz/fuzz_$t"
+  local corpus="$build/corpus/$t"
+  local findings="$build/findings/$t"
+  local log="$build/logs/$t.log"
   rm -rf "$corpus" "$findings"
   mkdir -p "$corpus" "$findings"
   cp -r "fuzz/corpus/$t/." "$corpus/"
-  args=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
-        -artifact_prefix="$findings/")
+  local args=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1
+              -artifact_prefix="$findings/")
+  local dict
   dict=$(dict_of "$t" || true)
   [ -n "$dict" ] && args+=(-dict="$dict")
   echo "fuzz: $t for ${seconds}s"
-  rc=0
+  local rc=0
   # The outer limit only catches a fuzzer that ignores -max_total_time (a hang outside an input).
   timeout --kill-after=10 $((seconds + 120)) "$exe" "${args[@]}" "$corpus" >"$log" 2>&1 || rc=$?
+  local execs cov ft units artifacts result=ok kind
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   cov=$(grep -o 'cov: [0-9]* ft: [0-9]*' "$log" | tail -1 | awk '{print $2 " " $4}' || true)
   read -r cov ft <<<"${cov:-? ?}"
   units=$(find "$corpus" -type f | wc -l)
   artifacts=$(find "$findings" -type f | sort | paste -sd ' ' -)
-  result=ok
   if [ "$rc" -ne 0 ] || [ -n "$artifacts" ]; then
-    failed=1
     kind=$(grep -o -m1 -E "terminate called after throwing an instance of '[^']*'" "$log" ||
            grep -o -m1 -E 'ERROR: (AddressSanitizer|LeakSanitizer|libFuzzer): [a-z-]+( memory leaks)?|[^ ]+: runtime error|[^ ]+: invariant violated' "$log" ||
            true)
     if [ "$rc" -eq 124 ] || [ "$rc" -eq 137 ]; then kind="hang (killed after $((seconds + 120)) s)"; fi
     result="FOUND: ${kind:-exit $rc} -> ${artifacts:-no reproducer} (log: $log)"
   fi
-  summary+=("$(printf '%-16s %10s %6s %7s %7s  %s' "$t" "${execs:-?}" "$cov" "$ft" "$units" "$result")")
+  printf '%-16s %10s %6s %7s %7s  %s\n' "$t" "${execs:-?}" "$cov" "$ft" "$units" "$result" \
+    >"$build/logs/$t.summary"
+  [ "$result" = ok ]
+}
+
+for t in "${targets[@]}"; do
+  [ -x "$build/fuzz/fuzz_$t" ] || { echo "fuzz: no target '$t' ($build/fuzz/fuzz_$t)" >&2; exit 2; }
+done
+parallel=${NERAF_FUZZ_PARALLEL:-1}
+failed=0
+running=0
+for t in "${targets[@]}"; do
+  if [ "$running" -ge "$parallel" ]; then
+    wait -n || failed=1
+    running=$((running - 1))
+  fi
+  run_target "$t" &
+  running=$((running + 1))
+done
+while [ "$running" -gt 0 ]; do
+  wait -n || failed=1
+  running=$((running - 1))
 done
 
 echo
 printf '%-16s %10s %6s %7s %7s  %s\n' target executions cov features corpus result
-printf '%s\n' "${summary[@]}"
+for t in "${targets[@]}"; do cat "$build/logs/$t.summary"; done
 exit $failed
