@@ -66,6 +66,7 @@ nlohmann::json make_audio_manifest(const data::RirSet& r) {
                       {"waveform_length", r.waveform_length},
                       {"aabb_min", vec_json(r.audio_aabb.min)},
                       {"aabb_max", vec_json(r.audio_aabb.max)}};
+  if (!r.sources_hash().empty()) m["sources_fnv1a"] = r.sources_hash();
   if (!r.max_len_source.empty()) m["max_len_source"] = r.max_len_source;
   if (!r.max_len_note.empty()) m["max_len_note"] = r.max_len_note;
   return m;
@@ -88,6 +89,18 @@ void check_audio_manifest(const nlohmann::json& manifest, const data::RirSet& ri
                 " vs " + now[key].dump() +
                 "); use the original --data (or, for neraf train, a new --out folder)");
   }
+  // The files' contents: runs and caches from before the hash have none, then the ids and poses
+  // above are all there is.
+  const nlohmann::json recorded = manifest.value("sources_fnv1a", nlohmann::json(""));
+  require(recorded.is_string(), "the run's data.json is damaged (audio.sources_fnv1a is " +
+                                    recorded.dump() + "); restore it or train a new run");
+  const std::string was = recorded, is = rirs.sources_hash();
+  require(was.empty() || is.empty() || was == is,
+          where +
+              ": its RIR files changed since the run was trained (same names and poses, other "
+              "contents: sources_fnv1a " +
+              was + " vs " + is +
+              "); restore the original files (or, for neraf train, use a new --out folder)");
 }
 
 void check_same_room_format(const nlohmann::json& manifest, const data::RirSet& rirs,
@@ -160,14 +173,8 @@ torch::Tensor AudioRun::predict_log_stft_batch(const torch::Tensor& mic, const t
 AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
                         const std::string& checkpoint, nerf::Precision precision, bool calibrated,
                         int64_t scene) {
-  std::error_code ec;
-  const std::string config_path = (fs::path(run_dir) / "config.json").string();
+  const std::string config_path = run_config_file(run_dir);
   const std::string manifest_path = (fs::path(run_dir) / "data.json").string();
-  require(fs::is_directory(run_dir, ec), run_dir + ": no such run folder; check --run");
-  require(fs::is_regular_file(config_path, ec),
-          run_dir +
-              ": not a training run (no config.json); point --run at a neraf train --out "
-              "folder");
   AudioRun out;
   out.run_.run_dir = run_dir;
   out.run_.config = read_run_config(config_path);
@@ -218,9 +225,17 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
     out.run_.step = step.item<int64_t>();
     c10::IValue legacy;  // checkpoints written before the calibration stage held their gains
     if (calibrated && out.run_.config.audio.energy_calibration) {
-      if (auto gains = load_calibration(out.run_.checkpoint, out.run_.step, out.scene_))
+      if (auto gains = load_calibration(out.run_.checkpoint, out.run_.step, out.scene_)) {
+        // [C, F, T] of this run's data (a file copied from another run has other sizes).
+        require(gains->sizes() == torch::IntArrayRef({info.channels, info.n_freq, info.max_len}),
+                calibration_path(out.run_.checkpoint) + ": fitted for another field (gains of " +
+                    std::to_string(gains->size(0)) + " channels x " +
+                    std::to_string(gains->size(1)) + " bins x " + std::to_string(gains->size(2)) +
+                    " frames; the run's data.json has " + std::to_string(info.channels) + " x " +
+                    std::to_string(info.n_freq) + " x " + std::to_string(info.max_len) +
+                    "); delete it and run neraf calibrate --run " + run_dir);
         out.calibration_ = gains->to(device);
-      else if (branch.try_read("calibration", legacy))
+      } else if (branch.try_read("calibration", legacy))
         out.calibration_ = legacy.toTensor().to(device);
       else
         warn(out.run_.checkpoint +
