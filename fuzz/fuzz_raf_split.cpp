@@ -2,8 +2,8 @@
 // data/pose_files.h) on any JSON text, walked as index_raf walks it. JSON that neraf::parse_json
 // refuses is its documented neraf::Error (fuzz_json_file covers that parser). The split functions
 // report every problem through the ProblemList and never throw; an id they accept is a plain
-// folder name of data/ (never a path), and a padded id is a whole number of at least 6 digits.
-// Anything else is a finding.
+// folder name of data/ (never a path, no control character), a padded id is a whole number of at
+// least 6 digits, and every problem is one line. Anything else is a finding.
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -38,9 +38,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       const auto before = problems.items().size();
       const auto id = detail::raf_split_id((*lists[li])[k], where, path, problems);
       NERAF_FUZZ_CHECK(problems.items().size() == before + (id ? 0 : 1));
-      if (!id) continue;
+      if (!id) {
+        // One line: the id is quoted with JSON escapes (a NUL or newline would cut or split it).
+        NERAF_FUZZ_CHECK(problems.items().back().to_string().find_first_of(
+                             std::string("\n\0", 2)) == std::string::npos);
+        continue;
+      }
       NERAF_FUZZ_CHECK(!id->empty() && *id != "." && *id != ".." &&
-                       id->find('/') == std::string::npos && id->find('\0') == std::string::npos);
+                       id->find('/') == std::string::npos);
+      for (char c : *id) NERAF_FUZZ_CHECK(static_cast<unsigned char>(c) >= 0x20 && c != 0x7f);
       if (const auto padded = detail::raf_padded_id(*id)) {
         NERAF_FUZZ_CHECK(padded->size() >= 6);
         NERAF_FUZZ_CHECK(padded->find_first_not_of("-0123456789") == std::string::npos);

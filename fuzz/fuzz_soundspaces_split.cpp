@@ -2,8 +2,8 @@
 // text, against a fixed points.txt of points 0..511. JSON that neraf::parse_json refuses is its
 // documented neraf::Error (fuzz_json_file covers that parser). The split parser reports every
 // problem through the ProblemList and never throws; the entries it hands on are listed once,
-// written as their numbers print (so no two name the same wav) and use defined points. Anything
-// else is a finding.
+// written as their numbers print (so no two name the same wav) and use defined points; every
+// problem is one line. Anything else is a finding.
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -47,7 +47,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         NERAF_FUZZ_CHECK(e.where.compare(0, e.train ? 6 : 5, e.train ? "train[" : "test[") == 0);
       });
   NERAF_FUZZ_CHECK(lists || (ids.empty() && problems.num_errors() == 1));
+  // One line each: entries are quoted with JSON escapes (a NUL or newline would cut or split it).
   for (const neraf::data::Problem& p : problems.items())
-    NERAF_FUZZ_CHECK(p.is_error() && p.file == path && !p.fix.empty());
+    NERAF_FUZZ_CHECK(p.is_error() && p.file == path && !p.fix.empty() &&
+                     p.to_string().find_first_of(std::string("\n\0", 2)) == std::string::npos);
   return 0;
 }

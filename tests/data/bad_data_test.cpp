@@ -272,6 +272,21 @@ TEST(BadData, SoundSpacesSplitEntryWrittenAnotherWay) {
                   "train[2] \"0/00_1\" is not \"<rot>/<receiver>_<source>\"");
 }
 
+// An entry or id is quoted with JSON escapes: a newline in it would split the one-line error, a
+// NUL cut it (and in a RAF id, end the folder's path early).
+TEST(BadData, SplitEntriesWithControlCharactersAreQuotedOnOneLine) {
+  SoundSpaces ss;
+  testing::write_text(ss.dir / "metadata_AudioNeRF/split.json",
+                      R"({"train": ["0/0_1\n", "90/1_2"], "test": ["180/1_0"]})");
+  expect_rejected(ss.dir.path(), "split.json", R"(train[0] "0/0_1\n" is not)");
+  Raf raf;
+  testing::write_text(raf.dir / "metadata/data-split.json",
+                      R"({"train": [["000001\n", "000000\u0000x", 2]], "test": [[5]]})");
+  expect_rejected(raf.dir.path(), "data-split.json", R"(train[0][0] "000001\n" is not an id)");
+  const std::string all = all_text(validate_dataset(raf.dir.path()));
+  EXPECT_NE(all.find(R"(train[0][1] "000000\u0000x" is not an id)"), std::string::npos) << all;
+}
+
 // F22: a source quaternion with a 90° roll was reduced to its yaw without a word. The published
 // code uses the yaw alone, so the data stays usable; info and training warn, naming the file.
 TEST(BadData, TiltedRafSourceIsAWarning) {

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "neraf/geometry/quaternion.h"
+#include "neraf/util/json_text.h"
 
 using nlohmann::json;
 
@@ -171,19 +172,20 @@ bool parse_soundspaces_split(const json& split, const std::string& split_path,
       e.id = list[k].get<std::string>();
       if (!parse_entry(e.id, e.rot, e.receiver, e.source)) {
         problems.error(split_path,
-                       e.where + " \"" + e.id + "\" is not \"<rot>/<receiver>_<source>\"",
+                       e.where + " " + json_quoted(e.id) + " is not \"<rot>/<receiver>_<source>\"",
                        "entries look like \"270/122_44\"");
         continue;
       }
       if (!seen.insert(e.id).second) {
-        problems.error(split_path, e.where + " \"" + e.id + "\" is listed twice (duplicate id)",
+        problems.error(split_path,
+                       e.where + " " + json_quoted(e.id) + " is listed twice (duplicate id)",
                        "remove the duplicate entry");
         continue;
       }
       const auto pr = points.find(e.receiver), ps = points.find(e.source);
       if (pr == points.end() || ps == points.end()) {
         problems.error(split_path,
-                       e.where + " \"" + e.id + "\" uses point " +
+                       e.where + " " + json_quoted(e.id) + " uses point " +
                            std::to_string(pr == points.end() ? e.receiver : e.source) +
                            ", which metadata/points.txt does not define",
                        "use the points.txt and split.json of the same scene");
@@ -233,10 +235,13 @@ std::optional<std::string> raf_split_id(const json& entry, const std::string& wh
     problems.error(split_path, where + " is not an id", "ids are numbers or \"000123\" strings");
     return std::nullopt;
   }
-  // A NUL would end the path early: "000001\0x" would read data/000001 as a second entry.
-  if (id.empty() || id.find('/') != std::string::npos || id.find('\0') != std::string::npos ||
-      id == "." || id == "..") {
-    problems.error(split_path, where + " \"" + id + "\" is not an id",
+  // A NUL would end the path early ("000001\0x" would read data/000001 a second time), and a
+  // newline in the folder named in a message would split it: the release's ids are digits.
+  const bool control = std::any_of(id.begin(), id.end(), [](char c) {
+    return static_cast<unsigned char>(c) < 0x20 || c == 0x7f;
+  });
+  if (id.empty() || id.find('/') != std::string::npos || control || id == "." || id == "..") {
+    problems.error(split_path, where + " " + json_quoted(id) + " is not an id",
                    "ids name folders of data/ (\"000123\"), not paths");
     return std::nullopt;
   }

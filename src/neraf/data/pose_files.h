@@ -63,7 +63,8 @@ std::array<const nlohmann::json*, 2> raf_split_lists(const nlohmann::json& split
 
 // Entry `where` ("train[0][5]") of a split list as the name of its folder in data/: a number
 // zero-padded to 6 digits ("000123", the release's folder names), or a string as written;
-// nullopt (with an error) for anything else or a string that is not a plain folder name.
+// nullopt (with an error) for anything else or a string that is not a plain folder name (a
+// path, ".", "..", a control character).
 std::optional<std::string> raf_split_id(const nlohmann::json& entry, const std::string& where,
                                         const std::string& split_path, ProblemList& problems);
 

@@ -22,6 +22,7 @@
 #include "neraf/io/audio_file.h"
 #include "neraf/io/json_file.h"
 #include "neraf/util/error.h"
+#include "neraf/util/json_text.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -99,12 +100,13 @@ RirIndex index_raf(const std::string& dir, ProblemList& problems) {
         }
       }
       if (!seen.insert(id).second) {
-        problems.error(split_path, where + " \"" + id + "\" is listed twice (duplicate id)",
+        problems.error(split_path,
+                       where + " " + json_quoted(id) + " is listed twice (duplicate id)",
                        "remove the duplicate id");
         continue;
       }
       if (!fs::is_directory(folder, ec)) {
-        problems.error(folder, "split entry " + where + " \"" + id + "\" has no folder",
+        problems.error(folder, "split entry " + where + " " + json_quoted(id) + " has no folder",
                        "restore data/" + id + " or remove the id from " + split_path);
         continue;
       }
@@ -118,7 +120,8 @@ RirIndex index_raf(const std::string& dir, ProblemList& problems) {
         continue;
       }
       if (!w.exists) {
-        problems.error(rir.wav_path, "split entry " + where + " \"" + id + "\" has no rir.wav",
+        problems.error(rir.wav_path,
+                       "split entry " + where + " " + json_quoted(id) + " has no rir.wav",
                        "restore the file or remove the id from " + split_path);
         continue;
       }

@@ -21,6 +21,7 @@
 #include "neraf/io/json_file.h"
 #include "neraf/io/npy.h"
 #include "neraf/util/error.h"
+#include "neraf/util/json_text.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -119,7 +120,8 @@ RirIndex index_soundspaces(const std::string& dir, bool use_magnitude_files,
           return;
         }
         if (!w.exists) {
-          problems.error(rir.wav_path, "split entry " + e.where + " \"" + e.id + "\" has no file",
+          problems.error(rir.wav_path,
+                         "split entry " + e.where + " " + json_quoted(e.id) + " has no file",
                          "restore the wav or remove the entry from " + split_path);
           return;
         }
