@@ -11,6 +11,7 @@
 #include "fixtures.h"
 #include "neraf/data/image_set.h"
 #include "neraf/data/rir_set.h"
+#include "neraf/data/transforms_json.h"
 #include "neraf/data/validate.h"
 #include "neraf/util/error.h"
 
@@ -216,6 +217,48 @@ TEST(BadData, IntrinsicOfTheWrongType) {
   EXPECT_EQ(all.find("no fl_x"), std::string::npos) << all;
 }
 
+// Probe round d, G09: focal lengths of 1e-320 or 2^53 + 1 pixels and a k1 of 1e308 were accepted
+// (only "positive and finite" was checked); each is named with its bounds.
+TEST(BadData, ImplausibleFocalLengthOrDistortion) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"\"fl_x\": 1e-320", "fl_x is 9.99989e-321, outside 0.001..1e+06 pixels"},
+      {"\"fl_x\": 9007199254740993", "fl_x is 9.0072e+15, outside 0.001..1e+06 pixels"},
+      {"\"k1\": 1e308", "distortion k1 is 1e+308, outside ±100"}};
+  for (const auto& [value, message] : cases) {
+    TempDir img;
+    NerfstudioScene().write(img.path());
+    std::string text = NerfstudioScene().json_text();
+    const std::string key = std::string(value).substr(0, std::string(value).find(':'));
+    const size_t at = text.find(key);
+    text.replace(at, text.find(',', at) - at, value);
+    testing::write_text(img / "transforms.json", text);
+    expect_rejected(img.path(), "transforms.json", message);
+  }
+  Intrinsics k;
+  k.fx = k.fy = 10;
+  EXPECT_EQ(intrinsics_problem(k), "");
+  k.fy = kMaxFocalPixels * 2;
+  EXPECT_EQ(intrinsics_problem(k), "fy is 2e+06, outside 0.001..1e+06 pixels");
+  k.fy = 10;
+  k.p2 = std::nan("");
+  EXPECT_EQ(intrinsics_problem(k), "distortion p2 is nan, outside ±100");
+}
+
+// G18: a NUL in file_path cut the path (the image before it was read); a control character in a
+// frame's path is refused, quoted with JSON escapes.
+TEST(BadData, FilePathWithAControlCharacter) {
+  TempDir img;
+  NerfstudioScene scene;
+  scene.write(img.path());
+  std::string text = scene.json_text();
+  const std::string first = "\"" + scene.names[0] + "\"";
+  text.replace(text.find(first), first.size(), "\"" + scene.names[0] + "\\u0000x\"");
+  testing::write_text(img / "transforms.json", text);
+  expect_rejected(
+      img.path(), "transforms.json",
+      "frames[0]: file_path \"" + scene.names[0] + "\\u0000x\" holds a control character");
+}
+
 // A RIR that is a symlink to a device (or a FIFO) is not a missing file: it is named as what it is.
 TEST(BadData, RirThatIsNotARegularFile) {
   Raf raf;
@@ -247,7 +290,7 @@ TEST(BadData, PointsTxtIndexOutOfRangeOrExtraColumn) {
                       "0\t1.0\t1.5\t2.0\n99999999999999999999\t-0.5\t1.5\t0.25\n"
                       "2\t2.5\t1.2\t-1.0\n3\t0.0\t1.8\t3.0\n");
   expect_rejected(big.dir.path(), "metadata/points.txt",
-                  "line 2: point index 99999999999999999999 is out of range");
+                  "line 2: point index \"99999999999999999999\" is out of range");
 
   SoundSpaces wide;
   std::string pts;
@@ -260,6 +303,19 @@ TEST(BadData, PointsTxtIndexOutOfRangeOrExtraColumn) {
   expect_rejected(wide.dir.path(), "metadata/points.txt", "line 1: more than 4 columns");
   const std::string all = all_text(validate_dataset(wide.dir.path()));
   EXPECT_NE(all.find("line 4: more than 4 columns"), std::string::npos) << all;
+}
+
+// F24: a NUL inside a points.txt line cut the error line ("got '0 1.3" and nothing after it):
+// the line is quoted with JSON escapes, whole, and the message goes on to its end.
+TEST(BadData, PointsTxtLineWithANulIsQuotedWhole) {
+  SoundSpaces ss;
+  testing::write_text(ss.dir / "metadata/points.txt",
+                      std::string("0\t1.3\0x\t1.5\t2.0\n", 16) +
+                          "1\t-0.5\t1.5\t0.25\n2\t2.5\t1.2\t-1.0\n3\t0.0\t1.8\t3.0\n");
+  expect_rejected(ss.dir.path(), "metadata/points.txt",
+                  R"(line 1: expected 'idx<TAB>x<TAB>y<TAB>z', got "0\t1.3\u0000x\t1.5\t2.0")");
+  for (const Problem& p : validate_dataset(ss.dir.path()))
+    EXPECT_EQ(p.to_string().find('\0'), std::string::npos) << p.to_string();
 }
 
 // A split entry names its wav file: "0/00_1" would be a second entry of 0/0_1.wav (the loader

@@ -105,10 +105,10 @@ std::map<long, geometry::Vec3> parse_points_txt(const std::string& text, const s
     int n = 0;
     while (n < 4 && ls >> tok[n]) ++n;
     if (n == 4 && ls >> extra) {
-      problems.error(
-          path,
-          where + ": more than 4 columns; expected 'idx<TAB>x<TAB>y<TAB>z', got '" + line + "'",
-          "remove the extra columns");
+      problems.error(path,
+                     where + ": more than 4 columns; expected 'idx<TAB>x<TAB>y<TAB>z', got " +
+                         json_quoted(line),
+                     "remove the extra columns");
       continue;
     }
     long id = 0;
@@ -121,13 +121,13 @@ std::map<long, geometry::Vec3> parse_points_txt(const std::string& text, const s
       id = std::strtol(tok[0].c_str(), &end, 10);
       ok = end == tok[0].c_str() + tok[0].size();
       if (ok && errno == ERANGE) {  // strtol clamps it to LONG_MAX / LONG_MIN
-        problems.error(path, where + ": point index " + tok[0] + " is out of range",
+        problems.error(path, where + ": point index " + json_quoted(tok[0]) + " is out of range",
                        "number the points 0, 1, 2, ... as the SoundSpaces release does");
         continue;
       }
     }
     if (!ok) {
-      problems.error(path, where + ": expected 'idx<TAB>x<TAB>y<TAB>z', got '" + line + "'",
+      problems.error(path, where + ": expected 'idx<TAB>x<TAB>y<TAB>z', got " + json_quoted(line),
                      "fix the line");
       continue;
     }

@@ -110,13 +110,16 @@ void read_pose(const json& frame, TransformsFrame& f, ProblemList& problems,
 
 void check_intrinsics(TransformsFrame& f, ProblemList& problems, const std::string& file) {
   const Intrinsics& k = f.intr;
-  const bool finite = std::isfinite(k.fx) && std::isfinite(k.fy) && std::isfinite(k.cx) &&
-                      std::isfinite(k.cy) && std::isfinite(k.k1) && std::isfinite(k.k2) &&
-                      std::isfinite(k.k3) && std::isfinite(k.p1) && std::isfinite(k.p2);
-  if (!finite || !(k.fx > 0) || !(k.fy > 0)) {
-    problems.error(file, frame_name(f) + ": focal lengths must be positive finite numbers",
-                   "set fl_x and fl_y (pixels) globally or per frame");
+  if (!std::isfinite(k.cx) || !std::isfinite(k.cy)) {
+    problems.error(file, frame_name(f) + ": cx and cy must be finite numbers",
+                   "set cx and cy (pixels) globally or per frame");
+    return;
   }
+  const std::string problem = intrinsics_problem(k, "fl_x", "fl_y");
+  if (!problem.empty())
+    problems.error(file, frame_name(f) + ": " + problem,
+                   "set fl_x and fl_y (pixels) and the distortion coefficients globally or per "
+                   "frame to the camera's calibration");
 }
 
 // Python's json module writes NaN / Infinity / -Infinity for non-finite floats, which strict JSON
@@ -163,10 +166,19 @@ bool whole_pixels(double v) { return v >= 1 && v <= kMaxImageSide && v == std::f
 
 bool contains(const std::string& s, const char* sub) { return s.find(sub) != std::string::npos; }
 
+bool has_control_character(const std::string& s) {
+  return std::any_of(s.begin(), s.end(),
+                     [](char c) { return static_cast<unsigned char>(c) < 0x20 || c == 0x7f; });
+}
+
 }  // namespace
 
 std::string frame_name(const TransformsFrame& f) {
-  return "frames[" + std::to_string(f.json_index) + "] (" + f.file_path + ")";
+  // A path that is long or holds a control character is quoted (and cut) by json_quoted, so the
+  // one-line messages stay one short line; the usual path reads as it is written.
+  const bool plain = f.file_path.size() <= kQuotedMaxBytes && !has_control_character(f.file_path);
+  return "frames[" + std::to_string(f.json_index) + "] (" +
+         (plain ? f.file_path : json_quoted(f.file_path)) + ")";
 }
 
 Transforms parse_transforms_json(const std::string& text, const std::string& json_path,
@@ -236,6 +248,14 @@ Transforms parse_transforms_json(const std::string& text, const std::string& jso
       continue;
     }
     f.file_path = fr["file_path"].get<std::string>();
+    // A NUL would end the path early (the file before it would be read), a newline split messages.
+    if (has_control_character(f.file_path)) {
+      problems.error(file,
+                     "frames[" + std::to_string(i) + "]: file_path " + json_quoted(f.file_path) +
+                         " holds a control character",
+                     "write the image's path relative to the transforms.json folder");
+      continue;
+    }
     f.path = (fs::path(out.data_dir) / f.file_path).lexically_normal().string();
 
     // Per-frame values win only when the global one is absent (nerfstudio semantics).
@@ -394,3 +414,28 @@ void split_transforms(const Transforms& p, const std::string& eval_mode, double 
 }
 
 }  // namespace neraf::data::detail
+
+namespace neraf::data {
+
+std::string intrinsics_problem(const Intrinsics& k, const char* fx_key, const char* fy_key) {
+  auto number = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return std::string(buf);
+  };
+  for (auto [key, v] : {std::pair<const char*, double>{fx_key, k.fx}, {fy_key, k.fy}})
+    if (!(v >= kMinFocalPixels && v <= kMaxFocalPixels))
+      return std::string(key) + " is " + number(v) + ", outside " + number(kMinFocalPixels) + ".." +
+             number(kMaxFocalPixels) + " pixels";
+  for (auto [key, v] : {std::pair<const char*, double>{"k1", k.k1},
+                        {"k2", k.k2},
+                        {"k3", k.k3},
+                        {"p1", k.p1},
+                        {"p2", k.p2}})
+    if (!(std::abs(v) <= kMaxAbsDistortion))
+      return std::string("distortion ") + key + " is " + number(v) + ", outside ±" +
+             number(kMaxAbsDistortion);
+  return "";
+}
+
+}  // namespace neraf::data

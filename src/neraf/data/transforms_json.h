@@ -20,6 +20,19 @@ struct Intrinsics {  // OPENCV camera model, pixels
   double k3 = 0;  // third radial coefficient (nerfstudio OPENCV also carries it; usually 0)
 };
 
+// Plausible camera intrinsics, shared by transforms.json and camera files (infer's
+// intrinsics_from_json): a focal length of 1e-320 or 9e15 pixels, or a k1 of 1e308, is damage,
+// not a camera. Real cameras lie far inside (phones ~3000 px, tele lenses on 8K sensors ~1e5 px;
+// OpenCV distortion coefficients are of order 1, fisheye fits a few tens).
+constexpr double kMinFocalPixels = 1e-3;
+constexpr double kMaxFocalPixels = 1e6;
+constexpr double kMaxAbsDistortion = 100;
+// "" when the focal lengths (fx, fy) and distortion (k1, k2, k3, p1, p2) of `k` are finite and
+// within those bounds, else what is wrong, naming the value with the keys `fx_key`/`fy_key` (a
+// transforms.json says fl_x, a camera file fx), e.g. "fl_x is 1e-320, outside 0.001..1e+06 pixels".
+std::string intrinsics_problem(const Intrinsics& k, const char* fx_key = "fx",
+                               const char* fy_key = "fy");
+
 namespace detail {
 
 // Largest |camera position| accepted (the scene's units, metres for every dataset neraf reads),

@@ -26,8 +26,8 @@ nlohmann::json parse_json(const std::string& text, const std::string& path,
   };
   try {
     nlohmann::json value = nlohmann::json::parse(text, check_keys);
-    require(duplicate.empty(),
-            path + ": the key \"" + duplicate + "\" appears twice in one object; keep one of them");
+    require(duplicate.empty(), path + ": the key " + json_quoted(duplicate) +
+                                   " appears twice in one object; keep one of them");
     return value;
   } catch (const nlohmann::json::parse_error& e) {
     throw Error(path + ": not valid JSON (at byte " + std::to_string(e.byte) + "); " + fix);
@@ -39,7 +39,19 @@ nlohmann::json parse_json(const std::string& text, const std::string& path,
 }
 
 std::string json_quoted(const std::string& text) {
-  return nlohmann::json(text).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  auto quote = [](const std::string& s) {
+    return nlohmann::json(s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  };
+  if (text.size() <= kQuotedMaxBytes) return quote(text);
+  // A 1 MB key must not make a 1 MB error line: keep the start, which names it well enough. The
+  // cut backs off to the start of a UTF-8 sequence (a continuation byte is 10xxxxxx), so a
+  // character is never split into bytes the quoting would replace.
+  size_t cut = kQuotedMaxBytes;
+  // (At most 3 steps: a longer run of continuation bytes is invalid UTF-8, replaced anyway.)
+  for (int i = 0; i < 3 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80; ++i) --cut;
+  size_t characters = 0;
+  for (const char c : text) characters += (static_cast<unsigned char>(c) & 0xC0) != 0x80;
+  return quote(text.substr(0, cut)) + "… (" + std::to_string(characters) + " characters)";
 }
 
 }  // namespace neraf

@@ -1,5 +1,6 @@
 #pragma once
 // Parsing JSON text strictly: errors name the file and say how to fix it.
+#include <cstddef>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -12,6 +13,9 @@ nlohmann::json parse_json(const std::string& text, const std::string& path,
 
 // `text` in double quotes with JSON escapes ("a\u0000b"), for quoting a key or string of a user's
 // file in a message: a NUL or newline in it would otherwise cut or split the one-line error.
+// Text longer than kQuotedMaxBytes is cut to its first kQuotedMaxBytes bytes (never inside a UTF-8
+// character) and followed by `… (N characters)`, so a huge key cannot make a huge message.
+constexpr size_t kQuotedMaxBytes = 200;
 std::string json_quoted(const std::string& text);
 
 }  // namespace neraf
