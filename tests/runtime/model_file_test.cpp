@@ -154,9 +154,9 @@ TEST(ModelFile, RoundTripFloat32) {
   neraf::rt::write_model_file(path, m);
   expect_same(neraf::rt::read_model_file(path), m);
   // Nothing else left in the folder (the temporary file was renamed).
-  EXPECT_EQ(std::distance(fs::directory_iterator(fs::path(path).parent_path()),
-                          fs::directory_iterator{}),
-            1);
+  EXPECT_EQ(
+      std::distance(fs::directory_iterator(fs::path(path).parent_path()), fs::directory_iterator{}),
+      1);
 }
 
 TEST(ModelFile, RoundTripBfloat16StoresRoundedWeights) {
@@ -253,7 +253,7 @@ TEST(ModelFile, WriterRejectsInvalidModels) {
   rejects(m, "box");
   m = random_model();
   m.metadata_json = "{not json";
-  rejects(m, "metadata_json");
+  rejects(m, "'metadata' is not valid JSON");
   m = random_model();
   m.neraf_version = std::string(40, 'x');
   rejects(m, "neraf_version");
@@ -330,7 +330,8 @@ TEST(ModelFile, EveryTruncationIsRejected) {
     ASSERT_EQ(e.status(), NERAF_ERR_FORMAT) << n << " bytes";
     const std::string msg = e.what();
     ASSERT_EQ(msg.rfind("cut.nrf: ", 0), 0u) << msg;
-    ASSERT_TRUE(msg.find("truncated") != std::string::npos || msg.find("empty") != std::string::npos)
+    ASSERT_TRUE(msg.find("truncated") != std::string::npos ||
+                msg.find("empty") != std::string::npos)
         << n << " bytes: " << msg;
   }
   // One byte too many is not a model either.
@@ -369,8 +370,9 @@ TEST(ModelFile, BadShapesBehindAValidChecksumAreRejected) {
     EXPECT_EQ(std::string(e.what()).rfind("edit.nrf: ", 0), 0u) << e.what();
   };
   // A layer far larger than the payload: rejected before allocating it.
-  expect(error_with_header(replaced(p.header, "[[24,163],[16,24]]", "[[1000000,163],[16,1000000]]")),
-         "the payload ends inside trunk[0].weight");
+  expect(
+      error_with_header(replaced(p.header, "[[24,163],[16,24]]", "[[1000000,163],[16,1000000]]")),
+      "the payload ends inside trunk[0].weight");
   expect(error_with_header(replaced(p.header, "[24,163]", "[24,162]")), "trunk[0]");
   expect(error_with_header(replaced(p.header, "\"channels\":2", "\"channels\":3")), "calibration");
   expect(error_with_header(replaced(p.header, "\"channels\":2", "\"channels\":-2")), "channels");
@@ -397,6 +399,71 @@ TEST(ModelFile, BadShapesBehindAValidChecksumAreRejected) {
   q = p;
   q.flags = 4;
   expect(parse_error(join(q), "edit.nrf"), "unknown flags");
+}
+
+// Probe round d, G08: a header edited behind a recomputed checksum was accepted with absurd values
+// (RIRs at +71 dBFS, a WAV at 1 Hz, a two-channel raf field, a key given twice, metadata that is
+// not JSON or disagrees with the header). Each is refused, naming the field.
+TEST(ModelFile, ImplausibleHeaderValuesAreRejected) {
+  ModelData m = random_model();
+  m.metadata_json =
+      R"({"step":2,"data":{"audio":{"layout":"soundspaces","sample_rate":22050,"channels":2,)"
+      R"("n_fft":64,"win_length":64,"hop_length":16,"n_freq":33,"max_len":12,)"
+      R"("waveform_length":0,"aabb_min":[-1.0,0.0,-2.0],"aabb_max":[3.0,2.5,1.5]}}})";
+  const std::vector<uint8_t> bytes = serialize_model(m);
+  ASSERT_NO_THROW(parse_model(bytes.data(), bytes.size(), "edit.nrf"));
+  const Parts p = split(bytes);
+  auto expect_refused = [&](const std::string& from, const std::string& to, const char* needle) {
+    Parts q = p;
+    q.header = replaced(p.header, from, to);
+    const ModelFileError e = parse_error(join(q), "edit.nrf");
+    EXPECT_EQ(e.status(), NERAF_ERR_FORMAT);
+    EXPECT_EQ(std::string(e.what()).rfind("edit.nrf: ", 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << to << ": " << e.what();
+  };
+  expect_refused("\"output_scale\":10.0", "\"output_scale\":1e308",
+                 "output_scale is 1e+308, outside (0, 30]");
+  expect_refused("\"leaky_slope\":0.1", "\"leaky_slope\":1e308",
+                 "leaky_slope is 1e+308, outside [0, 1]");
+  expect_refused("\"leaky_slope\":0.1", "\"leaky_slope\":-0.5", "leaky_slope");
+  expect_refused("\"extent_m\":[4.0,2.5,3.5]", "\"extent_m\":[4.0,1e-320,3.5]", "extent_m");
+  expect_refused("\"box_max\":[3.0,2.5,1.5]", "\"box_max\":[3.0,1e308,1.5]", "box_max");
+  expect_refused("\"box_min\":[-1.0,0.0,-2.0]", "\"box_min\":[-1.0,2.4999999,-2.0]",
+                 "at least 1 mm");
+  expect_refused("\"sample_rate\":22050", "\"sample_rate\":1",
+                 "'sample_rate' is 1, outside [8000, 384000]");
+  expect_refused("\"channels\":2", "\"channels\":2,\"channels\":2",
+                 "the key \"channels\" is given twice");
+  expect_refused("\"waveform_length\":0,", "\"waveform_length\":100,",
+                 "metadata data.audio.waveform_length 0 disagrees with the header's 100");
+  // The header and its metadata edited alike still make the old eval/render disagreement
+  // impossible; one of them alone is refused.
+  const std::string meta_rate = R"(\"sample_rate\":22050)";
+  expect_refused(meta_rate, R"(\"sample_rate\":48000)",
+                 "metadata data.audio.sample_rate 48000 disagrees with the header's 22050");
+  expect_refused("\"metadata\":\"", "\"metadata\":\"{{{\",\"x\":\"",
+                 "'metadata' is not valid JSON");
+
+  // A raf (mono) layout with two channels.
+  ModelData two = random_model();
+  two.layout = 1;
+  try {
+    serialize_model(two, "raf.nrf");
+    ADD_FAILURE() << "a two-channel raf model was written";
+  } catch (const ModelFileError& e) {
+    EXPECT_NE(std::string(e.what()).find("the raf layout (layout 1) is mono"), std::string::npos)
+        << e.what();
+  }
+  // Metadata with a key given twice, or not JSON, is refused by the writer as well.
+  ModelData meta = random_model();
+  meta.metadata_json = R"({"step":1,"step":2})";
+  EXPECT_THROW(serialize_model(meta, "meta.nrf"), ModelFileError);
+  meta.metadata_json = "{{{";
+  EXPECT_THROW(serialize_model(meta, "meta.nrf"), ModelFileError);
+  meta.metadata_json = std::string(40, '[') + std::string(40, ']');
+  EXPECT_THROW(serialize_model(meta, "meta.nrf"), ModelFileError);
+  meta.metadata_json = "";  // no metadata at all is fine
+  EXPECT_NO_THROW(serialize_model(meta, "meta.nrf"));
 }
 
 // Random edits of the header and arrays behind a valid checksum: every outcome is a parsed model
@@ -429,8 +496,10 @@ TEST(ModelFile, RandomEditsNeverCrash) {
       }
     }
     const ModelFileError e = parse_error(join(q));
-    if (e.status() == NERAF_OK) ++parsed;
-    else ASSERT_EQ(e.status(), NERAF_ERR_FORMAT) << e.what();
+    if (e.status() == NERAF_OK)
+      ++parsed;
+    else
+      ASSERT_EQ(e.status(), NERAF_ERR_FORMAT) << e.what();
   }
   EXPECT_LT(parsed, 3000);
 }

@@ -6,9 +6,11 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "neraf/runtime/stft_window.h"
 
@@ -22,7 +24,7 @@ namespace {
 using nlohmann::json;
 
 constexpr char kMagic[8] = {'N', 'E', 'R', 'A', 'F', 'M', 'D', 'L'};
-constexpr size_t kPrefixSize = 24;  // magic, version, flags, payload size
+constexpr size_t kPrefixSize = 24;                 // magic, version, flags, payload size
 constexpr size_t kFileOverhead = kPrefixSize + 8;  // + checksum
 // Bounds that no real model reaches (preset paper: ~61 MB, widths ≤ 5096) but that keep a
 // corrupt or hostile header from asking for absurd work or memory.
@@ -32,6 +34,15 @@ constexpr int kMaxJsonDepth = 16;
 constexpr int64_t kMaxWidth = int64_t(1) << 20;
 constexpr size_t kMaxLayers = 64;
 constexpr size_t kMaxVersionLength = sizeof(neraf_model_info{}.neraf_version) - 1;  // 31
+// Plausible values of what export writes (exported_model.cpp): an edited header with a valid
+// checksum must not give RIRs at +71 dBFS or a WAV at 1 Hz. Sample rates as the data loaders take
+// them; NAcF's output_scale is 10 and its leaky_slope 0.1 in every neraf model (NacfOptions, not
+// flags), output_scale ≤ 30 keeps exp(out) and its square finite in float32; positions within
+// 10 km (every pose file's bound) in a box and extent at least 1 mm wide.
+constexpr int kMinSampleRate = 8000, kMaxSampleRate = 384000;
+constexpr double kMaxOutputScale = 30;
+constexpr double kMaxAbsCoordinate = 1e4;
+constexpr double kMinSideM = 1e-3;
 
 [[noreturn]] void format_error(const std::string& name, const std::string& what) {
   throw ModelFileError(NERAF_ERR_FORMAT, name + ": " + what);
@@ -85,9 +96,8 @@ json header_json(const ModelData& m) {
   h["output_scale"] = m.output_scale;
   h["trunk"] = shapes(m.trunk);
   h["heads"] = shapes(m.heads);
-  h["calibration"] = m.calibration.empty()
-                         ? json::array()
-                         : json::array({m.channels, m.n_freq, m.max_len});
+  h["calibration"] =
+      m.calibration.empty() ? json::array() : json::array({m.channels, m.n_freq, m.max_len});
   h["weight_dtype"] = m.bf16_storage ? "bfloat16" : "float32";
   h["metadata"] = m.metadata_json;
   return h;
@@ -100,9 +110,12 @@ bool json_depth_ok(const char* s, size_t n, int max_depth) {
   for (size_t i = 0; i < n; ++i) {
     const char c = s[i];
     if (in_string) {
-      if (escaped) escaped = false;
-      else if (c == '\\') escaped = true;
-      else if (c == '"') in_string = false;
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
     } else if (c == '"') {
       in_string = true;
     } else if (c == '[' || c == '{') {
@@ -167,8 +180,7 @@ class Header {
     std::vector<DenseLayer> out(v.size());
     for (size_t i = 0; i < v.size(); ++i) {
       const json& s = v[i];
-      if (!s.is_array() || s.size() != 2 || !s[0].is_number_integer() ||
-          !s[1].is_number_integer())
+      if (!s.is_array() || s.size() != 2 || !s[0].is_number_integer() || !s[1].is_number_integer())
         bad(key, "entry " + std::to_string(i) + " is not an [out, in] pair of integers");
       out[i].out = dim(s[0], key);
       out[i].in = dim(s[1], key);
@@ -312,22 +324,97 @@ void write_all(int fd, const uint8_t* p, size_t n) {
   }
 }
 
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
+}
+
+std::string vec3_text(const std::array<double, 3>& v) {
+  return "[" + number_text(v[0]) + ", " + number_text(v[1]) + ", " + number_text(v[2]) + "]";
+}
+
+// A short, one-line rendering of JSON from the file for a message (escapes, at most ~80 bytes).
+std::string json_text_for_message(const json& v) {
+  const std::string s = v.dump(-1, ' ', false, json::error_handler_t::replace);
+  return s.size() <= 80 ? s : s.substr(0, 80) + "...";
+}
+
+// JSON text parsed as neraf's other readers parse it (util/json_text.h, which the runtime may not
+// link): a key given twice in one object is refused, not silently the last one. Returns a
+// discarded value for text that is not JSON; `duplicate` gets the first key given twice.
+json parse_strict(const char* text, size_t size, std::string& duplicate) {
+  std::vector<std::set<std::string>> keys;  // of each open object
+  const json::parser_callback_t note_keys = [&](int, json::parse_event_t event, json& parsed) {
+    using Event = json::parse_event_t;
+    if (event == Event::object_start) keys.emplace_back();
+    if (event == Event::object_end && !keys.empty()) keys.pop_back();
+    if (event == Event::key && !keys.empty() &&
+        !keys.back().insert(parsed.get<std::string>()).second && duplicate.empty())
+      duplicate = parsed.get<std::string>();
+    return true;
+  };
+  return json::parse(text, text + size, note_keys, /*allow_exceptions=*/false);
+}
+
+// The free-form metadata must be JSON (export writes an object; eval reads its "data" entry).
+// Where it holds the run's audio manifest (export's "data"."audio"), it must agree with the
+// header: eval reads the metadata and render the header, so an edit of one alone would make the
+// two commands disagree about the same file without a word.
+void check_metadata(const ModelData& m, const std::string& name) {
+  if (m.metadata_json.empty()) return;
+  const std::string& text = m.metadata_json;
+  if (!json_depth_ok(text.data(), text.size(), kMaxJsonDepth))
+    format_error(name, "header: field 'metadata' is JSON nested too deeply");
+  std::string duplicate;
+  const json meta = parse_strict(text.data(), text.size(), duplicate);
+  if (meta.is_discarded()) format_error(name, "header: field 'metadata' is not valid JSON text");
+  if (!duplicate.empty())
+    format_error(name, "header: field 'metadata' gives the key " +
+                           json_text_for_message(json(duplicate)) + " twice in one object");
+  const auto data = meta.is_object() ? meta.find("data") : meta.end();
+  if (data == meta.end() || !data->is_object()) return;
+  const auto audio = data->find("audio");
+  if (audio == data->end() || !audio->is_object()) return;
+  const auto agree = [&](const char* key, const json& header_value) {
+    const auto it = audio->find(key);
+    if (it != audio->end() && *it != header_value)
+      format_error(name, std::string("metadata data.audio.") + key + " " +
+                             json_text_for_message(*it) + " disagrees with the header's " +
+                             json_text_for_message(header_value) +
+                             "; the file was edited: export it again from its run");
+  };
+  agree("layout", m.layout == 1 ? "raf" : "soundspaces");
+  agree("sample_rate", m.sample_rate);
+  agree("channels", m.channels);
+  agree("n_fft", m.n_fft);
+  agree("win_length", m.win_length);
+  agree("hop_length", m.hop_length);
+  agree("n_freq", m.n_freq);
+  agree("max_len", m.max_len);
+  agree("waveform_length", m.waveform_length);
+  agree("aabb_min", vec3(m.box_min));
+  agree("aabb_max", vec3(m.box_max));
+}
+
 // Everything but the arrays' contents: sizes, STFT parameters, shapes and their chaining (what
 // the reader can check before reading, and allocating, any array).
 void check_config(const ModelData& m, const std::string& name) {
-  if (m.neraf_version.size() > kMaxVersionLength ||
-      m.neraf_version.find('\0') != std::string::npos)
+  if (m.neraf_version.size() > kMaxVersionLength || m.neraf_version.find('\0') != std::string::npos)
     format_error(name, "neraf_version '" + m.neraf_version.substr(0, 40) +
                            "' is longer than 31 bytes or holds a NUL");
   check_range(m.layout, 0, 1, "layout (0 soundspaces, 1 raf)", name);
-  check_range(m.sample_rate, 1, 1000000, "sample_rate", name);
+  check_range(m.sample_rate, kMinSampleRate, kMaxSampleRate, "sample_rate", name);
   check_range(m.channels, 1, 16, "channels", name);
+  if (m.layout == 1 && m.channels != 1)
+    format_error(name, "channels is " + std::to_string(m.channels) +
+                           ", but the raf layout (layout 1) is mono");
   check_range(m.n_fft, 2, 1 << 16, "n_fft", name);
   check_range(m.win_length, 1, m.n_fft, "win_length", name);
   check_range(m.hop_length, 1, m.n_fft, "hop_length", name);
   if (m.n_freq != m.n_fft / 2 + 1)
-    format_error(name, "n_freq " + std::to_string(m.n_freq) + " is not n_fft/2 + 1 = " +
-                           std::to_string(m.n_fft / 2 + 1));
+    format_error(name, "n_freq " + std::to_string(m.n_freq) +
+                           " is not n_fft/2 + 1 = " + std::to_string(m.n_fft / 2 + 1));
   check_range(m.max_len, 2, 1 << 16, "max_len (frames)", name);
   check_range(m.waveform_length, 0, int64_t(1) << 26, "waveform_length", name);
   // The implicit length hop·(T − 1) gets the same bound: the RIR length sizes Griffin-Lim's
@@ -338,16 +425,26 @@ void check_config(const ModelData& m, const std::string& name) {
     format_error(name, "hop_length " + std::to_string(m.hop_length) +
                            " leaves gaps between the Hann windows of " +
                            std::to_string(m.win_length) + " (no inverse STFT)");
-  if (!finite3(m.box_min) || !finite3(m.box_max) || !(m.box_min[0] < m.box_max[0]) ||
-      !(m.box_min[1] < m.box_max[1]) || !(m.box_min[2] < m.box_max[2]))
-    format_error(name, "the box must be finite with box_min < box_max on every axis");
-  if (!finite3(m.extent_m) || !(m.extent_m[0] > 0 && m.extent_m[1] > 0 && m.extent_m[2] > 0))
-    format_error(name, "extent_m must be finite and positive");
+  for (int a = 0; a < 3; ++a) {
+    if (!(std::fabs(m.box_min[a]) <= kMaxAbsCoordinate) ||
+        !(std::fabs(m.box_max[a]) <= kMaxAbsCoordinate) ||
+        !(m.box_max[a] - m.box_min[a] >= kMinSideM))
+      format_error(name, "box_min " + vec3_text(m.box_min) + " / box_max " + vec3_text(m.box_max) +
+                             ": the box must lie within ±10000 m with box_max at least 1 mm "
+                             "above box_min on every axis");
+    if (!(m.extent_m[a] >= kMinSideM && m.extent_m[a] <= 2 * kMaxAbsCoordinate))
+      format_error(name, "extent_m " + vec3_text(m.extent_m) +
+                             " must be within [0.001, 20000] m on every axis");
+  }
   if (!(std::fabs(m.position_max_freq_exp) <= 30.0))
     format_error(name, "position_max_freq_exp must be finite, within [-30, 30]");
-  if (!std::isfinite(m.leaky_slope)) format_error(name, "leaky_slope must be finite");
-  if (!(m.output_scale > 0 && std::isfinite(m.output_scale)))
-    format_error(name, "output_scale must be finite and positive");
+  if (!(m.leaky_slope >= 0 && m.leaky_slope <= 1))
+    format_error(name, "leaky_slope is " + number_text(m.leaky_slope) +
+                           ", outside [0, 1] (neraf models use 0.1)");
+  if (!(m.output_scale > 0 && m.output_scale <= kMaxOutputScale))
+    format_error(name, "output_scale is " + number_text(m.output_scale) +
+                           ", outside (0, 30] (neraf models use 10)");
+  check_metadata(m, name);
 
   if (m.trunk.empty() || m.trunk.size() > kMaxLayers)
     format_error(name, "the trunk must have 1 to " + std::to_string(kMaxLayers) + " layers");
@@ -362,15 +459,15 @@ void check_config(const ModelData& m, const std::string& name) {
                              " values, " + layer_name("trunk", i + 1) + " takes " +
                              std::to_string(m.trunk[i + 1].in));
   if (m.heads.size() != size_t(m.channels))
-    format_error(name, std::to_string(m.heads.size()) + " heads for " +
-                           std::to_string(m.channels) + " channels");
+    format_error(name, std::to_string(m.heads.size()) + " heads for " + std::to_string(m.channels) +
+                           " channels");
   check_shapes(m.heads, "heads", name);
   for (size_t c = 0; c < m.heads.size(); ++c)
     if (m.heads[c].in != m.trunk.back().out || m.heads[c].out != m.n_freq)
       format_error(name, layer_name("heads", c) + " is [" + std::to_string(m.heads[c].out) + ", " +
                              std::to_string(m.heads[c].in) + "], expected [" +
-                             std::to_string(m.n_freq) + ", " +
-                             std::to_string(m.trunk.back().out) + "]");
+                             std::to_string(m.n_freq) + ", " + std::to_string(m.trunk.back().out) +
+                             "]");
 }
 
 }  // namespace
@@ -402,9 +499,7 @@ void check_model_data(const ModelData& m, const std::string& name) {
 }
 
 std::vector<uint8_t> serialize_model(const ModelData& m, const std::string& name) {
-  check_model_data(m, name);
-  if (!m.metadata_json.empty() && !json::accept(m.metadata_json))
-    format_error(name, "metadata_json is not valid JSON text");
+  check_model_data(m, name);  // (the metadata's JSON too)
   std::string header;
   try {
     header = header_json(m).dump(-1, ' ', false, json::error_handler_t::strict);
@@ -485,17 +580,17 @@ ModelData parse_model(const uint8_t* data, size_t size, const std::string& name)
   const uint64_t payload_size = get_u64(data + 16);
   if (version == 0) format_error(name, "invalid format version 0");
   if (version > kModelFormatVersion)
-    throw ModelFileError(NERAF_ERR_VERSION,
-                         name + ": written by a newer neraf (format " + std::to_string(version) +
-                             ", this reads up to " + std::to_string(kModelFormatVersion) +
-                             "); update neraf");
+    throw ModelFileError(NERAF_ERR_VERSION, name + ": written by a newer neraf (format " +
+                                                std::to_string(version) + ", this reads up to " +
+                                                std::to_string(kModelFormatVersion) +
+                                                "); update neraf");
   if (flags & ~kModelFlagBf16) format_error(name, "unknown flags " + std::to_string(flags));
   if (size < kFileOverhead || payload_size > size - kFileOverhead)
-    format_error(name, "truncated (" + std::to_string(size) + " bytes, the header declares " +
-                           (payload_size > kMaxFileSize
-                                ? std::string("more than 16 GiB")
-                                : std::to_string(payload_size + kFileOverhead)) +
-                           ")");
+    format_error(name,
+                 "truncated (" + std::to_string(size) + " bytes, the header declares " +
+                     (payload_size > kMaxFileSize ? std::string("more than 16 GiB")
+                                                  : std::to_string(payload_size + kFileOverhead)) +
+                     ")");
   if (payload_size < size - kFileOverhead)
     format_error(name, std::to_string(size - kFileOverhead - payload_size) +
                            " unexpected bytes after the model");
@@ -511,14 +606,18 @@ ModelData parse_model(const uint8_t* data, size_t size, const std::string& name)
   const char* text = reinterpret_cast<const char*>(payload + 8);
   if (!json_depth_ok(text, header_size, kMaxJsonDepth))
     format_error(name, "header: JSON nested too deeply");
-  const json j = json::parse(text, text + header_size, nullptr, /*allow_exceptions=*/false);
+  std::string duplicate;
+  const json j = parse_strict(text, header_size, duplicate);
   if (j.is_discarded() || !j.is_object()) format_error(name, "header is not a JSON object");
+  if (!duplicate.empty())
+    format_error(name,
+                 "header: the key " + json_text_for_message(json(duplicate)) + " is given twice");
   const Header h(j, name);
 
   ModelData m;
   m.neraf_version = h.string("neraf_version");
   m.layout = int(h.integer("layout", 0, 1));
-  m.sample_rate = int(h.integer("sample_rate", 1, 1000000));
+  m.sample_rate = int(h.integer("sample_rate", kMinSampleRate, kMaxSampleRate));
   m.channels = int(h.integer("channels", 1, 16));
   m.n_fft = int(h.integer("n_fft", 2, 1 << 16));
   m.win_length = int(h.integer("win_length", 1, 1 << 16));
@@ -543,8 +642,8 @@ ModelData parse_model(const uint8_t* data, size_t size, const std::string& name)
   m.bf16_storage = dtype == "bfloat16";
   if (m.bf16_storage != bool(flags & kModelFlagBf16))
     format_error(name, "header: weight_dtype disagrees with the file's flags");
-  if (!cal.empty() && (cal.size() != 3 || cal[0] != m.channels || cal[1] != m.n_freq ||
-                       cal[2] != m.max_len))
+  if (!cal.empty() &&
+      (cal.size() != 3 || cal[0] != m.channels || cal[1] != m.n_freq || cal[2] != m.max_len))
     format_error(name, "header: the calibration shape is not [channels, n_freq, max_len]");
 
   check_config(m, name);  // shapes first: no array is read (or allocated) for a bad header
@@ -580,8 +679,7 @@ ModelData read_model_file(const std::string& path) {
     throw ModelFileError(NERAF_ERR_IO, path + ": cannot read (" + std::strerror(errno) + ")");
   if (S_ISDIR(st.st_mode))
     throw ModelFileError(NERAF_ERR_IO, path + ": is a folder, not a model file");
-  if (!S_ISREG(st.st_mode))
-    throw ModelFileError(NERAF_ERR_IO, path + ": not a regular file");
+  if (!S_ISREG(st.st_mode)) throw ModelFileError(NERAF_ERR_IO, path + ": not a regular file");
   if (uint64_t(st.st_size) > kMaxFileSize)
     format_error(path, "too large to be a neraf model (" + std::to_string(st.st_size) + " bytes)");
   std::vector<uint8_t> bytes(size_t(st.st_size));

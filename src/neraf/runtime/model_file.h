@@ -21,7 +21,8 @@
 // bf16 file's ModelData holds the rounded values, and the engine computes in float32 with them).
 //
 // Readers of format 1 ignore unknown header keys (a later writer may add optional fields without
-// a new version); any change a format-1 reader would misread bumps kModelFormatVersion.
+// a new version) but refuse a key given twice; any change a format-1 reader would misread bumps
+// kModelFormatVersion.
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -64,15 +65,17 @@ struct ModelData {
   double position_max_freq_exp = 8.0;       // mic/source NeRF encoding's highest exponent
   std::array<double, 3> extent_m{1, 1, 1};  // for the relative geometry (metres)
   double leaky_slope = 0.1, output_scale = 10.0;
-  std::vector<DenseLayer> trunk;  // LeakyReLU after each
-  std::vector<DenseLayer> heads;  // one per channel, [F, W]; out = output_scale·tanh(.)
+  std::vector<DenseLayer> trunk;   // LeakyReLU after each
+  std::vector<DenseLayer> heads;   // one per channel, [F, W]; out = output_scale·tanh(.)
   std::vector<float> calibration;  // [C, F, T] energy gains, or empty
 
   bool bf16_storage = false;  // write the weights as bfloat16 (export --precision bf16)
   std::string metadata_json;  // free-form JSON text (frames, data manifest, training summary)
 
   // The canonical input width trunk[0] must take: 163, or 185 with relative_geometry.
-  int64_t input_dim() const { return kPoseInputDim + (relative_geometry ? kRelativeGeometryDim : 0); }
+  int64_t input_dim() const {
+    return kPoseInputDim + (relative_geometry ? kRelativeGeometryDim : 0);
+  }
   // Samples per channel of a rendered RIR (waveform_length, or hop·(T−1) when 0).
   int64_t rir_length() const {
     return waveform_length > 0 ? waveform_length : int64_t(hop_length) * (max_len - 1);
@@ -109,7 +112,10 @@ ModelData parse_model(const uint8_t* data, size_t size, const std::string& name)
 
 // Throws ModelFileError(NERAF_ERR_FORMAT, "<name>: ...") unless `m` is a model the runtime can
 // run: sane sizes and STFT parameters, consistent shapes and layer chaining, array lengths that
-// match them, finite values.
+// match them, finite values; plausible ones (sample rate 8000..384000 Hz, output_scale in
+// (0, 30], leaky_slope in [0, 1], a box within ±10 km and an extent at least 1 mm wide on every
+// axis, a mono raf layout); metadata_json empty or JSON without a key given twice, agreeing with
+// the header where it holds the run's audio manifest ("data"."audio", what export writes).
 void check_model_data(const ModelData& m, const std::string& name);
 
 // bfloat16 conversion (round to nearest, ties to even; finite inputs) and back (exact). Inline:
