@@ -585,6 +585,51 @@ run "$NERAF" train --out "$TMP/resume_run" --resume --steps 3 --quiet
   fail "resume on a changed RIR file: exit $got: $(tail -c 400 "$TMP/err")"
 D=""
 
+# probe round d (helper)
+# G13 metrics of an RIR shorter than one STFT window (or 50 ms): refused naming the file, not "nan".
+float_wav "$TMP/short_rir.wav" 22050 1 0 5
+bad "$TMP/short_rir.wav" "$NERAF" metrics --pred "$TMP/short_rir.wav" --gt "$TMP/short_rir.wav"
+float_wav "$TMP/long_rir.wav" 22050 1 0.5
+run "$NERAF" metrics --pred "$TMP/long_rir.wav" --gt "$TMP/long_rir.wav"
+[ "$got" -eq 0 ] || fail "metrics of a 2000-sample RIR exited $got: $(tail -c 300 "$TMP/err")"
+# G09 camera files with a focal length of 1e-320 px or a k1 of 1e308.
+python3 - "$BASE/run/data.json" "$TMP" <<'PY'
+import json, sys
+c2w = json.load(open(sys.argv[1]))["eval_camera_to_world"][0]
+json.dump({"camera_to_world": c2w, "intrinsics": {"fx": 1e-320, "fy": 1e-320}},
+          open(sys.argv[2] + "/cam_fxsub.json", "w"))
+json.dump({"camera_to_world": c2w, "intrinsics": {"k1": 1e308}},
+          open(sys.argv[2] + "/cam_k1big.json", "w"))
+PY
+bad "fx is" "$NERAF" render view --run "$BASE/run" --pose "$TMP/cam_fxsub.json" --out @OUT@.png
+bad "k1 is" "$NERAF" render view --run "$BASE/run" --pose "$TMP/cam_k1big.json" --out @OUT@.png
+# G18 a NUL in data.json's dataset path (the folder before it was read).
+fresh run_datanul run; json_edit "$D/data.json" 'd["data"] = d["data"] + "\u0000junk"'
+bad "$D/data.json" "$NERAF" render rir --run "$D" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 --out @OUT@.wav
+D=""
+# G17 a scene light of 1e308 or a texture cell of 1e-320 m.
+cp "$TMP/demo_scene.json" "$TMP/sc_light.json"; json_edit "$TMP/sc_light.json" 'd["light"]["intensity"] = 1e308'
+bad "light.intensity" "$NERAF" synth --scene "$TMP/sc_light.json" --dry-run
+cp "$TMP/demo_scene.json" "$TMP/sc_tex.json"; json_edit "$TMP/sc_tex.json" 'd["materials"]["wall"]["texture"]["scale_m"] = 1e-320'
+bad "texture.scale_m" "$NERAF" synth --scene "$TMP/sc_tex.json" --dry-run
+# G08 a model whose header was edited behind a recomputed checksum.
+python3 - "$BASE/model.nrf" "$TMP/oscale.nrf" <<'PY'
+import json, struct, sys
+b = open(sys.argv[1], "rb").read()
+payload = b[24:-8]
+n = struct.unpack("<Q", payload[:8])[0]
+h = json.loads(payload[8:8 + n])
+h["output_scale"] = 1e308
+t = json.dumps(h).encode()
+payload = struct.pack("<Q", len(t)) + t + payload[8 + n:]
+fnv = 0xcbf29ce484222325
+for c in payload:
+    fnv = ((fnv ^ c) * 0x100000001b3) & 0xFFFFFFFFFFFFFFFF
+open(sys.argv[2], "wb").write(b[:16] + struct.pack("<Q", len(payload)) + payload + struct.pack("<Q", fnv))
+PY
+bad "output_scale" "$NERAF" render rir --model "$TMP/oscale.nrf" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 \
+  --out @OUT@.wav
+
 # P23 info takes the transforms.json form as train does.
 run "$NERAF" info --no-t60 "$BASE/ss/transforms.json"
 [ "$got" -eq 0 ] || fail "info DS/transforms.json exited $got: $(tail -c 300 "$TMP/err")"

@@ -93,3 +93,47 @@ TEST(RunManifest, IntrinsicsRoundTripAndRefuseNoSize) {
   j["width"] = 1e30;
   EXPECT_THROW(intrinsics_from_json(j, "data.json"), neraf::Error);
 }
+
+// Probe round d, G09: a camera file's focal length of 1e-320 or 2^53 + 1 pixels, or a k1 of 1e308,
+// rendered a flat picture without a word; the bounds are transforms.json's.
+TEST(RunManifest, IntrinsicsOutsidePlausibleBoundsAreRefused) {
+  const json good = json::parse(R"({"fx": 10, "fy": 11, "cx": 6, "cy": 4, "width": 12,
+                                    "height": 8})");
+  EXPECT_NO_THROW(intrinsics_from_json(good, "cam.json: intrinsics"));
+  const std::pair<const char*, double> cases[] = {
+      {"fx", 1e-320}, {"fy", 9007199254740993.0}, {"k1", 1e308}, {"p2", -101}};
+  for (const auto& [key, value] : cases) {
+    json j = good;
+    j[key] = value;
+    try {
+      intrinsics_from_json(j, "cam.json: intrinsics");
+      ADD_FAILURE() << key << " " << value << " accepted";
+    } catch (const neraf::Error& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind("cam.json: intrinsics: ", 0), 0u) << what;
+      EXPECT_NE(what.find(std::string(key) + " is "), std::string::npos) << what;
+    }
+  }
+}
+
+// G18: a NUL in data.json's "data" cut the dataset path (the folder before it was read).
+TEST(RunManifest, DataPathWithAControlCharacterIsRefused) {
+  EXPECT_NO_THROW(check_data_paths(json::parse(R"({"data": "/data/ss"})"), "run/data.json"));
+  EXPECT_NO_THROW(check_data_paths(json::parse(R"({"format": "x"})"), "run/data.json"));
+  try {
+    check_data_paths(json::parse(R"({"data": "/data/ss\u0000junk"})"), "run/data.json");
+    ADD_FAILURE() << "a NUL in data was accepted";
+  } catch (const neraf::Error& e) {
+    EXPECT_STREQ(e.what(),
+                 "run/data.json: is damaged (data \"/data/ss\\u0000junk\" holds a control "
+                 "character); restore it or re-run neraf train");
+  }
+  const json multi = json::parse(R"({"scenes": [{"data": "/a"}, {"data": "/b\nc"}]})");
+  try {
+    check_data_paths(multi, "run/data.json");
+    ADD_FAILURE() << "a newline in a scene's data was accepted";
+  } catch (const neraf::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("scenes[1].data \"/b\\nc\""), std::string::npos)
+        << e.what();
+  }
+}

@@ -142,6 +142,39 @@ TEST(SceneJson, TexturesAreChecked) {
   EXPECT_EQ(c, "scene.json: materials.wood.texture.contrast: must be a number in [0, 1]");
   // The string shorthand works.
   EXPECT_EQ(error_with([](json& j) { j["materials"]["wood"]["texture"] = "checker"; }), "");
+  // Probe round d, G17: a texture cell of 1e-320 m was accepted (noise at any image size).
+  for (const double scale : {1e-320, 1e-4, 2e3}) {
+    const std::string t = error_with([&](json& j) {
+      j["materials"]["wood"]["texture"] = {{"kind", "checker"}, {"scale_m", scale}};
+    });
+    EXPECT_EQ(t,
+              "scene.json: materials.wood.texture.scale_m: must be a number of metres in "
+              "[0.001, 1000]")
+        << scale;
+  }
+  EXPECT_EQ(error_with([](json& j) {
+              j["materials"]["wood"]["texture"] = {{"kind", "checker"}, {"scale_m", 0.06}};
+            }),
+            "");
+  // A long unknown kind is quoted cut, so the error stays a short line (G12).
+  const std::string long_kind = error_with([](json& j) {
+    j["materials"]["wood"]["texture"] = {{"kind", std::string(100000, 'q')}};
+  });
+  EXPECT_LT(long_kind.size(), 500u);
+  EXPECT_NE(long_kind.find("(100000 characters)"), std::string::npos) << long_kind.substr(0, 500);
+}
+
+// G17: light.intensity 1e308 was accepted (every lit pixel white); the light terms are bounded.
+TEST(SceneJson, LightTermsAreBounded) {
+  for (const char* key : {"intensity", "ambient"}) {
+    for (const double v : {1e308, 101.0, -1.0}) {
+      const std::string e = error_with([&](json& j) { j["light"][key] = v; });
+      EXPECT_EQ(e, std::string("scene.json: light.") + key + ": must be a number in [0, 100]")
+          << key << " " << v;
+    }
+    EXPECT_EQ(error_with([&](json& j) { j["light"][key] = 100; }), "") << key;
+    EXPECT_EQ(error_with([&](json& j) { j["light"][key] = 0; }), "") << key;
+  }
 }
 
 TEST(SceneJson, BoxesMustStayInsideTheRoom) {

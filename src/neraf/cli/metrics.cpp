@@ -1,7 +1,9 @@
 // `neraf metrics`: room-acoustic parameters of one RIR file, or the errors of a predicted RIR
 // against the ground truth, with the published NeRAF evaluation semantics (src/neraf/metrics/).
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -86,9 +88,27 @@ void run_single(const MetricsArgs& args, metrics::Variant variant) {
   }
 }
 
+// The errors need one STFT window of the ground truth (the STFT error has no frame without it)
+// and energy after C50's 50 ms split (C50 is +inf on both sides without it): shorter, every
+// such error printed "nan", even for two identical files.
+void require_scorable_length(const io::AudioBuffer& gt, const std::string& name,
+                             metrics::Variant variant) {
+  const int64_t window = metrics::stft_params(variant).n_fft;
+  const int64_t split = metrics::c50_split_sample(gt.sample_rate);
+  const int64_t needed = std::max(window, split + 1);
+  if (gt.num_frames() >= needed) return;
+  throw Error(name + ": " + std::to_string(gt.num_frames()) +
+              " samples is too short to score: the " + metrics::to_string(variant) +
+              " STFT error needs a " + std::to_string(window) +
+              "-sample window and C50 energy after 50 ms (sample " + std::to_string(split) +
+              " at " + std::to_string(gt.sample_rate) + " Hz); give the whole impulse response, " +
+              "at least " + std::to_string(needed) + " samples");
+}
+
 void run_compare(const MetricsArgs& args, metrics::Variant variant) {
   const io::AudioBuffer pred = io::read_audio(args.pred);
   const io::AudioBuffer gt = io::read_audio(args.gt);
+  require_scorable_length(gt, args.gt, variant);
   const metrics::RirErrors e = metrics::compare_rirs(pred, gt, variant, args.pred, args.gt);
   note_sample_rate(gt.sample_rate, variant);
   if (pred.num_frames() > gt.num_frames()) {
@@ -138,7 +158,8 @@ void register_metrics(CLI::App& app) {
       "difference; STFT error = mean |log(|STFT(pred)|+1e-3) - log(|STFT(gt)|+1e-3)| over\n"
       "len(gt)/hop frames (the paper reports it for raf only). A shorter prediction is "
       "zero-padded\n"
-      "at the end to the ground truth's length. Values that cannot be measured print as\n"
+      "at the end to the ground truth's length; a ground truth shorter than one STFT window or\n"
+      "than 50 ms + 1 sample is refused. Values that cannot be measured print as\n"
       "'invalid'/'nan'/'inf' and as null in JSON.\n"
       "Examples:\n"
       "  neraf metrics --rir assets/real/brir_clap.wav\n"

@@ -183,6 +183,7 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
               ": this run has no acoustic field (trained with --modality vision); train "
               "with --modality joint or audio");
   out.run_.manifest = io::read_json(manifest_path);
+  check_data_paths(out.run_.manifest, manifest_path);
   if (is_multiscene(out.run_.manifest)) {
     const std::vector<std::string> names = scene_names(out.run_.manifest);
     std::string list;

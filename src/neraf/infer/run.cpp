@@ -224,6 +224,7 @@ LoadedRun load_run(const std::string& run_dir, torch::Device device,
   run.run_dir = run_dir;
   run.config = read_run_config(config_path);
   run.manifest = io::read_json(manifest_path);
+  check_data_paths(run.manifest, manifest_path);
   require(!is_multiscene(run.manifest),
           run_dir +
               ": a multi-scene acoustic run has no radiance field of its own; use its "

@@ -1,9 +1,11 @@
 #include "neraf/infer/run_manifest.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
 #include "neraf/util/error.h"
+#include "neraf/util/json_text.h"
 
 namespace neraf::infer {
 
@@ -36,6 +38,22 @@ int64_t find_scene(const nlohmann::json& m, const std::string& selector, const s
   throw Error(flag + " " + selector + ": " + run_dir + " has no such scene; its scenes are " +
               (list.empty() ? std::string("none (it is a one-scene run: drop ") + flag + ")"
                             : list + " (give a name or an index)"));
+}
+
+void check_data_paths(const nlohmann::json& m, const std::string& where) {
+  auto check = [&](const nlohmann::json& one, const std::string& key) {
+    if (!one.is_object() || !one.contains("data") || !one["data"].is_string()) return;
+    const std::string& path = one["data"].get_ref<const std::string&>();
+    const bool control = std::any_of(path.begin(), path.end(), [](char c) {
+      return static_cast<unsigned char>(c) < 0x20 || c == 0x7f;
+    });
+    require(!control, where + ": is damaged (" + key + " " + json_quoted(path) +
+                          " holds a control character); restore it or re-run neraf train");
+  };
+  check(m, "data");
+  if (is_multiscene(m))
+    for (size_t s = 0; s < m["scenes"].size(); ++s)
+      check(m["scenes"][s], "scenes[" + std::to_string(s) + "].data");
 }
 
 namespace {
@@ -98,8 +116,10 @@ AudioRunInfo audio_info_from_manifest(const nlohmann::json& a, const std::string
     const geometry::Vec3 &lo = info.aabb.min, &hi = info.aabb.max;
     for (double v : {lo.x, lo.y, lo.z, hi.x, hi.y, hi.z})
       check(std::isfinite(v), "aabb_min/aabb_max", a["aabb_min"], "expected finite metres");
-    check(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z, "aabb_min", a["aabb_min"],
-          "expected at most aabb_max " + a["aabb_max"].dump() + " on every axis");
+    // The box is the train microphones +- 1 m: at least 2 m wide; a flat one is a damaged file.
+    check(hi.x - lo.x >= 1e-3 && hi.y - lo.y >= 1e-3 && hi.z - lo.z >= 1e-3, "aabb_min",
+          a["aabb_min"],
+          "expected at least 1 mm below aabb_max " + a["aabb_max"].dump() + " on every axis");
     info.sample_rate = static_cast<int>(sample_rate);
     info.channels = static_cast<int>(channels);
     info.stft.n_fft = static_cast<int>(n_fft);
@@ -148,8 +168,12 @@ data::Intrinsics intrinsics_from_json(const nlohmann::json& j, const std::string
   k.k3 = num("k3", 0, false);
   k.p1 = num("p1", 0, false);
   k.p2 = num("p2", 0, false);
-  require(k.fx > 0 && k.fy > 0 && std::isfinite(k.fx) && std::isfinite(k.fy),
-          where + ": fx and fy must be positive");
+  // The bounds transforms.json gets (data::intrinsics_problem): a camera file's focal length of
+  // 1e-320 rendered a flat picture without a word.
+  const std::string problem = data::intrinsics_problem(k);
+  require(problem.empty(), where + ": " + problem +
+                               "; give the camera's focal lengths (pixels) and distortion as "
+                               "calibrated");
   require(k.width > 0 && k.height > 0 && k.width <= 16384 && k.height <= 16384,
           where + ": width and height must be in 1..16384");
   return k;

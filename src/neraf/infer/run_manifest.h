@@ -28,6 +28,11 @@ std::vector<std::string> scene_names(const nlohmann::json& data_manifest);
 int64_t find_scene(const nlohmann::json& data_manifest, const std::string& selector,
                    const std::string& run_dir, const std::string& flag = "--scene");
 
+// neraf::Error naming `where` (RUN/data.json) when the dataset path it records ("data", and each
+// scene's) holds a control character: a NUL would end the path early, so the folder before it
+// would be read without a word.
+void check_data_paths(const nlohmann::json& data_manifest, const std::string& where);
+
 // The acoustic field's data, from the "audio" entry of RUN/data.json (make_audio_manifest,
 // audio_run.h) or an exported model's header.
 struct AudioRunInfo {

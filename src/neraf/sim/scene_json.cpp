@@ -125,7 +125,7 @@ Texture read_texture(const Ctx& c, const json& j, const std::string& path) {
     return read_string(c, v, p, "one of \"none\", \"checker\", \"stripes\", \"noise\"");
   });
   opt(j, "scale_m", path, t.scale_m, [&](const json& v, const std::string& p) {
-    return read_number(c, v, p, "a positive number (metres)");
+    return read_number(c, v, p, "a number of metres in [0.001, 1000]");
   });
   opt(j, "contrast", path, t.contrast, [&](const json& v, const std::string& p) {
     return read_number(c, v, p, "a number in [0, 1]");
@@ -308,8 +308,8 @@ Scene scene_from_json(const json& j, const std::string& origin) {
     const std::string p = "light";
     check_object(c, *m, p, {"position", "intensity", "ambient"});
     opt(*m, "position", p, s.light.position, vec3(kThreeNumbers));
-    opt(*m, "intensity", p, s.light.intensity, number("a number >= 0"));
-    opt(*m, "ambient", p, s.light.ambient, number("a number >= 0"));
+    opt(*m, "intensity", p, s.light.intensity, number("a number in [0, 100]"));
+    opt(*m, "ambient", p, s.light.ambient, number("a number in [0, 100]"));
   }
 
   if (const json* m = find(j, "acoustics")) {
@@ -384,10 +384,10 @@ void validate_scene(const Scene& s, const std::string& origin) {
     const auto& t = m.texture;
     if (t.kind != "none" && t.kind != "checker" && t.kind != "stripes" && t.kind != "noise")
       fail(c, p + ".texture.kind",
-           "unknown texture \"" + t.kind +
-               "\"; use one of \"none\", \"checker\", \"stripes\", \"noise\"");
-    if (!(t.scale_m > 0 && std::isfinite(t.scale_m)))
-      fail(c, p + ".texture.scale_m", "must be a positive number (metres)");
+           "unknown texture " + json_quoted(t.kind) +
+               "; use one of \"none\", \"checker\", \"stripes\", \"noise\"");
+    if (!(t.scale_m >= kMinTextureScaleM && t.scale_m <= kMaxTextureScaleM))
+      fail(c, p + ".texture.scale_m", "must be a number of metres in [0.001, 1000]");
     if (!(t.contrast >= 0 && t.contrast <= 1))
       fail(c, p + ".texture.contrast", "must be a number in [0, 1]");
     for (double a : m.absorption) {
@@ -402,7 +402,7 @@ void validate_scene(const Scene& s, const std::string& origin) {
     std::string known;
     for (const auto& kv : s.materials) known += (known.empty() ? "" : ", ") + kv.first;
     fail(c, path,
-         "unknown material \"" + name + "\" (defined: " + known +
+         "unknown material " + json_quoted(name) + " (defined: " + known +
              "); define it under \"materials\"");
   };
   check_material(s.surfaces.floor, "surfaces.floor");
@@ -452,13 +452,15 @@ void validate_scene(const Scene& s, const std::string& origin) {
     if (!(std::abs(src.yaw_deg) <= kMaxYawDeg))
       fail(c, p + ".yaw_deg", "must be a number of degrees in [-1e6, 1e6]");
     if (src.directivity != "omni" && src.directivity != "cardioid")
-      fail(c, p + ".directivity",
-           "unknown directivity \"" + src.directivity + "\"; use \"omni\" or \"cardioid\"");
+      fail(
+          c, p + ".directivity",
+          "unknown directivity " + json_quoted(src.directivity) + "; use \"omni\" or \"cardioid\"");
   }
 
   const Microphones& mic = s.microphones;
   if (mic.kind != "grid" && mic.kind != "random")
-    fail(c, "microphones.kind", "unknown kind \"" + mic.kind + "\"; use \"grid\" or \"random\"");
+    fail(c, "microphones.kind",
+         "unknown kind " + json_quoted(mic.kind) + "; use \"grid\" or \"random\"");
   {
     const auto& g = mic.grid;
     const std::string p = "microphones.grid";
@@ -538,10 +540,10 @@ void validate_scene(const Scene& s, const std::string& origin) {
   }
 
   check_point(s.light.position, "light.position", "light");
-  if (!(s.light.intensity >= 0 && std::isfinite(s.light.intensity)))
-    fail(c, "light.intensity", "must be a number >= 0");
-  if (!(s.light.ambient >= 0 && std::isfinite(s.light.ambient)))
-    fail(c, "light.ambient", "must be a number >= 0");
+  if (!(s.light.intensity >= 0 && s.light.intensity <= kMaxLightTerm))
+    fail(c, "light.intensity", "must be a number in [0, 100]");
+  if (!(s.light.ambient >= 0 && s.light.ambient <= kMaxLightTerm))
+    fail(c, "light.ambient", "must be a number in [0, 100]");
 
   const auto& ac = s.acoustics;
   // Air is 343 m/s, water ~1500, steel ~6000: beyond [1, 10000] m/s a typo is likelier.

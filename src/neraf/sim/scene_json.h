@@ -48,5 +48,10 @@ constexpr int kMaxGridMicrophones = 1000000;
 constexpr int kMaxReflectionOrder = 60;
 // Yaw angles as timed paths bound them (docs/PATH_FORMAT.md): larger ones lose the degrees.
 constexpr double kMaxYawDeg = 1e6;
+// The picture is albedo · texture · (ambient + intensity · n·l), clipped to [0, 1]: beyond 100
+// every lit pixel is white (the presets use 0.8–1.0 and 0.25). A texture cell under a millimetre
+// is noise at any image size, one over a kilometre is flat (the presets use 0.06–0.6 m).
+constexpr double kMaxLightTerm = 100;
+constexpr double kMinTextureScaleM = 1e-3, kMaxTextureScaleM = 1e3;
 
 }  // namespace neraf::sim

@@ -26,6 +26,7 @@
 #include "neraf/sim/scene_json.h"
 #include "neraf/sim/seeded_random.h"
 #include "neraf/util/error.h"
+#include "neraf/util/json_text.h"
 #include "neraf/util/log.h"
 #include "neraf/util/progress.h"
 
@@ -298,10 +299,10 @@ SynthSummary write_dataset(const Scene& scene, const SynthOptions& options, cons
 
 SynthSummary synthesize(const Scene& scene, const SynthOptions& options) {
   const auto t_start = std::chrono::steady_clock::now();
-  validate_scene(scene, "scene \"" + scene.name + "\"");
-  check_synthesis_size(scene, options.layout, "scene \"" + scene.name + "\"");
+  validate_scene(scene, "scene " + json_quoted(scene.name));
+  check_synthesis_size(scene, options.layout, "scene " + json_quoted(scene.name));
   const SynthPlan plan = plan_synthesis(scene, options.layout, options.seed);
-  check_sound_reaches_microphones(scene, plan, "scene \"" + scene.name + "\"");
+  check_sound_reaches_microphones(scene, plan, "scene " + json_quoted(scene.name));
   check_out_dir(options.out_dir, options.force);
   // A failure (bad HRTF, full disk, Ctrl-C) leaves no half-written dataset behind.
   SynthSummary sum;
