@@ -585,6 +585,53 @@ run "$NERAF" train --out "$TMP/resume_run" --resume --steps 3 --quiet
   fail "resume on a changed RIR file: exit $got: $(tail -c 400 "$TMP/err")"
 D=""
 
+# --- probe round d (docs/results/fresh_probes_2026-12-04b.md) ---
+# G01 a user's files whose names merely hold ".tmp-<digits>" survive the stale-temporary cleanup.
+mkdir -p "$TMP/keep"
+echo precious >"$TMP/keep/notes.tmp-123456.txt"
+cp "$DRY" "$TMP/keep/take.tmp-2024.wav"
+mkdir "$TMP/keep/photos.tmp-77777"
+run "$NERAF" export --run "$BASE/run" --out "$TMP/keep/m.nrf"
+[ "$got" -eq 0 ] && [ -f "$TMP/keep/notes.tmp-123456.txt" ] && [ -f "$TMP/keep/take.tmp-2024.wav" ] &&
+  [ -d "$TMP/keep/photos.tmp-77777" ] || fail "export deleted a user's .tmp- files (exit $got)"
+echo '{"version": 1, "source": [1.1, 1.2, 0.9], "poses": [{"name": "take.tmp-1", "mic": [2, 1.5, 2.5]}]}' \
+  >"$TMP/tmp_name_poses.json"
+bad "take.tmp-1" "$NERAF" render rir --model "$BASE/model.nrf" --poses "$TMP/tmp_name_poses.json" \
+  --out @OUT@
+# G02 an absurd OMP_NUM_THREADS is ignored with a warning, not a crash.
+OMP_NUM_THREADS=100000 run "$NERAF" render rir --model "$BASE/model.nrf" --mic 2.0,1.5,2.5 \
+  --src 1.1,1.2,0.9 --out "$TMP/omp.wav"
+[ "$got" -eq 0 ] && grep -q "^warning: OMP_NUM_THREADS=100000: ignored" "$TMP/err" ||
+  fail "OMP_NUM_THREADS=100000: exit $got: $(tail -c 300 "$TMP/err")"
+# G03/G19 FIFOs where a file is read: refused at once, not waited on.
+mkfifo "$TMP/fifo.nrf" "$TMP/fifo.json" "$TMP/checkpoint_fifo.pt"
+bad "$TMP/fifo.nrf" "$NERAF" render rir --model "$TMP/fifo.nrf" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 \
+  --out @OUT@.wav
+bad "$TMP/fifo.json" "$NERAF" render trajectory --model "$BASE/model.nrf" --path "$TMP/fifo.json" \
+  --in "$DRY" --out @OUT@.wav
+bad "not a regular file" "$NERAF" render rir --run "$BASE/run" --checkpoint "$TMP/checkpoint_fifo.pt" \
+  --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 --out @OUT@.wav
+# G05 a file-size limit fails the write with one line and leaves no temporary file.
+next_out
+(ulimit -f 20; run "$NERAF" render rir --model "$BASE/model.nrf" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 \
+  --out "$O.wav"; echo "$got" >"$TMP/ulimit_rc")
+got=$(cat "$TMP/ulimit_rc")
+[ "$got" -eq 1 ] && grep -q "^error: " "$TMP/err" || fail "ulimit -f: exit $got: $(tail -c 300 "$TMP/err")"
+ls "$TMP" | grep -q "o_$case_no.wav" && fail "ulimit -f: left $(ls "$TMP" | grep "o_$case_no")"
+# G16 a flat training box in data.json is a damaged file, not the user's position.
+fresh run_flatbox run; json_edit "$D/data.json" 'd["audio"]["aabb_max"] = d["audio"]["aabb_min"]'
+bad "$D/data.json" "$NERAF" render rir --run "$D" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 --out @OUT@.wav
+D=""
+# G07 eval after the held-out pictures changed: refused (the run recorded their pixels).
+fresh ss_evalpix ss
+run "$NERAF" train --data "$D" --out "$TMP/vision_run" --modality vision --steps 2 --rays 64 --quiet
+[ "$got" -eq 0 ] || fail "vision train for the eval case: exit $got: $(tail -c 300 "$TMP/err")"
+train_pngs=("$D"/images/train_*.png)
+eval_pngs=("$D"/images/eval_*.png)
+cp "${train_pngs[0]}" "${eval_pngs[0]}"
+bad "eval_pixels_fnv1a" "$NERAF" eval --run "$TMP/vision_run" --json @OUT@.json --no-images --quiet
+D=""
+
 # probe round d (helper)
 # G13 metrics of an RIR shorter than one STFT window (or 50 ms): refused naming the file, not "nan".
 float_wav "$TMP/short_rir.wav" 22050 1 0 5

@@ -552,8 +552,8 @@ TEST(PoseList, NamesMustBeUnique) {
 
 TEST(PoseList, NamesMustBeSafeFileNames) {
   for (const std::string& bad :
-       std::vector<std::string>{"", "../x", "a/b", ".hidden", "..", "a b", "a\\b", "caf\xc3\xa9",
-                                "x\ny", std::string(kMaxPoseNameLength + 1, 'a')}) {
+       std::vector<std::string>{"", "../x", "a/b", ".hidden", "..", "a b", "take.tmp-42", "a\\b",
+                                "caf\xc3\xa9", "x\ny", std::string(kMaxPoseNameLength + 1, 'a')}) {
     // Quoted as JSON quotes it, so a backslash or newline cannot garble the one-line message.
     std::string quoted;
     for (char c : bad) quoted += c == '\\' ? "\\\\" : c == '\n' ? "\\n" : std::string(1, c);

@@ -177,14 +177,24 @@ TEST_F(AtomicFileTest, StaleTemporariesOfDeadProcessesAreRemoved) {
   ASSERT_GT(child, 0);
   ::waitpid(child, nullptr, 0);  // a PID that no process has now
   const std::string dead = std::to_string(child), alive = std::to_string(::getppid());
-  write_text_atomically((dir_ / ("ckpt.pt.tmp-" + dead)).string(), "left by a kill");
-  fs::create_directory(dir_ / (".set.tmp-" + dead));
-  write_text_atomically((dir_ / ("model.nrf.tmp-" + dead + ".tmp-Ab12Cd")).string(), "x");
-  write_text_atomically((dir_ / ("other.tmp-" + alive)).string(), "a live writer's");
+  write_text_atomically((dir_ / ("ckpt.pt.neraf.tmp-" + dead)).string(), "left by a kill");
+  fs::create_directory(dir_ / (".set.neraf.tmp-" + dead));
+  write_text_atomically((dir_ / ("model.nrf.neraf.tmp-" + dead + ".tmp-Ab12Cd")).string(), "x");
+  write_text_atomically((dir_ / ("other.neraf.tmp-" + alive)).string(), "a live writer's");
   write_text_atomically((dir_ / "plain.txt").string(), "data");
+  // A user's names that merely hold ".tmp-<digits>" are not neraf's temporaries (a probe lost
+  // such files to an unanchored match).
+  for (const std::string& user :
+       {"notes.tmp-" + dead + ".txt", "take.tmp-" + dead, "photos.neraf.tmp-" + dead + ".wav"})
+    write_text_atomically((dir_ / user).string(), "the user's");
+  fs::create_directory(dir_ / ("album.tmp-" + dead));
   EXPECT_EQ(remove_stale_temporaries(dir_.string()), 3);
-  EXPECT_TRUE(fs::exists(dir_ / ("other.tmp-" + alive)));
+  EXPECT_TRUE(fs::exists(dir_ / ("other.neraf.tmp-" + alive)));
   EXPECT_TRUE(fs::exists(dir_ / "plain.txt"));
+  EXPECT_TRUE(fs::exists(dir_ / ("notes.tmp-" + dead + ".txt")));
+  EXPECT_TRUE(fs::exists(dir_ / ("take.tmp-" + dead)));
+  EXPECT_TRUE(fs::exists(dir_ / ("photos.neraf.tmp-" + dead + ".wav")));
+  EXPECT_TRUE(fs::exists(dir_ / ("album.tmp-" + dead)));
   EXPECT_EQ(remove_stale_temporaries(dir_.string()), 0);
 }
 

@@ -106,6 +106,13 @@ TEST_F(CApi, OutsideTheBoxNeedsTheFlag) {
   EXPECT_EQ(log_query(p, NERAF_ALLOW_OUTSIDE), NERAF_OK) << error();
   EXPECT_EQ(rir_query(p, NERAF_ALLOW_OUTSIDE), NERAF_OK) << error();
   EXPECT_EQ(log_query(inside_, 1u << 5), NERAF_ERR_INVALID_ARGUMENT);  // unknown flag
+  // The box is open, as the input encoding (a position on a face is encoded as zeros), and as
+  // the neraf command line checks it.
+  p = inside_;
+  p.mic[0] = 3.0;
+  EXPECT_EQ(log_query(p), NERAF_ERR_OUTSIDE);
+  p.mic[0] = -1.0;
+  EXPECT_EQ(rir_query(p), NERAF_ERR_OUTSIDE);
 }
 
 TEST_F(CApi, SmallCapacityIsRejected) {

@@ -389,7 +389,7 @@ TEST(LayoutSynth, RefusesANonEmptyFolderUnlessForced) {
   for (const auto& e : fs::recursive_directory_iterator(out))
     EXPECT_EQ(e.path().string().find(".tmp-"), std::string::npos) << e.path();
   for (const auto& e : fs::directory_iterator(out.parent_path()))
-    EXPECT_EQ(e.path().filename().string().find("." + out.filename().string() + ".tmp-"),
+    EXPECT_EQ(e.path().filename().string().find("." + out.filename().string() + ".neraf.tmp-"),
               std::string::npos)
         << e.path();
   // A synthesis that fails half-way (a bad HRTF file, after the pictures) leaves the old dataset

@@ -77,10 +77,7 @@ void auralize_and_write(const io::AudioBuffer& rir, const std::string& rir_name,
     level = "peak-normalised to 0.99 (gain " + format_db(gain, "dB") + ")";
   } else {
     level = "peak " + format_db(peak);
-    if (peak > 1.0f) {
-      warn(args.out_path + ": peak " + format_db(peak) +
-           " exceeds full scale; the float WAV keeps it, but playback will clip; pass --normalize");
-    }
+    warn_above_full_scale(wet, args.out_path, "pass --normalize");
   }
   io::write_audio(args.out_path, wet);
   std::printf("wrote %s: %d ch, %d Hz, %.2f s, %s\n", args.out_path.c_str(), wet.num_channels(),

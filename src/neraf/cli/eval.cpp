@@ -444,10 +444,14 @@ nlohmann::json evaluate_vision_json(infer::LoadedRun& run, const EvalArgs& args,
   const data::ImageSet images = data::load_transforms_json(data_dir, load);
   // The eval cameras must be the ones the run was trained against (same normalisation).
   const nlohmann::json now = infer::make_data_manifest(images, data_dir);
-  for (const char* key : {"num_train", "eval_files", "world_scale"})
+  // The held-out pictures and cameras too (runs from before the pixel hash have none).
+  for (const char* key :
+       {"num_train", "eval_files", "world_scale", "eval_intrinsics", "eval_pixels_fnv1a"}) {
+    if (!run.manifest.contains(key)) continue;
     require(now[key] == run.manifest[key],
             data_dir + ": differs from the dataset the run was trained on (" + key +
                 "); pass the original dataset with --data");
+  }
   eval::VisionEvalOptions opts;
   opts.chunk = run.config.eval_rays_per_chunk;
   opts.max_views = args.max_views;
@@ -571,15 +575,24 @@ void register_eval(CLI::App& app) {
     folder_inputs.push_back({"--json", args->json});
     require_safe_output_folder({"--images", args->images}, folder_inputs, args->run);
     require_cache_folder({"--cache-dir", args->cache_dir}, args->run);
+    // The PNGs and per-RIR CSVs: --images, else RUN/eval or MODEL_eval beside the model.
+    const std::string shown =
+        !args->images.empty() ? args->images
+        : args->run.empty()
+            ? std::filesystem::path(args->model).replace_extension("").string() + "_eval"
+            : (std::filesystem::path(args->run) / "eval").string();
     if (args->images.empty()) {
-      // The PNGs and per-RIR CSVs go beside the run or model unless --images says otherwise.
-      const std::string beside =
-          args->run.empty() ? std::filesystem::path(args->model).parent_path().string() : args->run;
-      require(::access(beside.empty() ? "." : beside.c_str(), W_OK) == 0,
-              (beside.empty() ? std::string(".") : beside) + ": not writable (" +
-                  std::strerror(errno) +
-                  "); eval writes its comparison PNGs and per-RIR CSVs there by default: pass "
-                  "--images DIR, a writable folder for them");
+      std::string beside = std::filesystem::path(shown).parent_path().string();
+      if (beside.empty()) beside = ".";
+      const bool writable = ::access(beside.c_str(), W_OK) == 0;
+      const int why = errno;  // before the message is built
+      std::error_code ec;
+      const std::string fix =
+          "eval writes its comparison PNGs and per-RIR CSVs there by default: pass --images DIR, "
+          "a writable folder for them";
+      require(writable, beside + ": not writable (" + std::strerror(why) + "); " + fix);
+      require(!std::filesystem::exists(shown, ec) || std::filesystem::is_directory(shown, ec),
+              shown + ": exists and is not a folder; " + fix);
     }
     if (!args->model.empty()) {
       const infer::ExportedModel model = infer::load_exported_model(args->model);
@@ -604,10 +617,6 @@ void register_eval(CLI::App& app) {
                             {"run", meta.value("run", std::string())},
                             {"checkpoint", meta.value("checkpoint", std::string())},
                             {"step", meta.value("step", int64_t{0})}};
-      const std::string shown =
-          args->images.empty()
-              ? std::filesystem::path(args->model).replace_extension("").string() + "_eval"
-              : args->images;
       io::write_folder_atomically(
           shown,
           [&](const std::string& tmp) {
@@ -620,8 +629,6 @@ void register_eval(CLI::App& app) {
     const std::string config_path = infer::run_config_file(args->run);
     const infer::TrainConfig cfg = infer::read_run_config(config_path);
     nlohmann::json out = {{"run", args->run}};
-    const std::string shown =
-        args->images.empty() ? (std::filesystem::path(args->run) / "eval").string() : args->images;
     io::write_folder_atomically(
         shown,
         [&](const std::string& tmp) {

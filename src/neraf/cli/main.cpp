@@ -3,10 +3,12 @@
 // 130 stopped by Ctrl-C / SIGTERM after saving what it could (training's checkpoint).
 #include <fftw3.h>
 #include <malloc.h>
+#include <sys/resource.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <new>
@@ -102,9 +104,29 @@ void refuse_empty_values(CLI::App& command) {
     refuse_empty_values(*sub);
 }
 
+// OpenBLAS and LibTorch reserve address space when they start; under a small `ulimit -v` OpenBLAS
+// retries its failing reservation for ever (a hang at 1 GB). "" when the limit is absent or ample.
+std::string address_space_problem() {
+  constexpr rlim_t kNeeded = rlim_t{2} << 30;
+  struct rlimit limit {};
+  if (::getrlimit(RLIMIT_AS, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY ||
+      limit.rlim_cur >= kNeeded)
+    return "";
+  return "the address-space limit (ulimit -v) is " + std::to_string(limit.rlim_cur >> 20) +
+         " MiB; neraf needs at least " + std::to_string(kNeeded >> 20) +
+         " MiB (LibTorch and OpenBLAS reserve address space at start): raise it with ulimit -v";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  // A file-size limit (ulimit -f) then fails the write with EFBIG, which the writers report and
+  // clean up after, instead of killing the process mid-write.
+  std::signal(SIGXFSZ, SIG_IGN);
+  if (const std::string why = address_space_problem(); !why.empty()) {
+    std::fprintf(stderr, "error: %s\n", why.c_str());
+    return 1;
+  }
   tune_malloc();
   // neraf_dsp and neraf_rt plan FFTs under their own locks; eval and render trajectory use both
   // from several threads, so FFTW's (process-global) planner must be safe across them.

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -210,6 +211,7 @@ void add_render_rir(CLI::App& render) {
     }
     std::string summary;
     const io::AudioBuffer rir = render_rir_from_field(field, args->field, args->pose, &summary);
+    warn_above_full_scale(rir, args->out, "");
     io::write_audio(args->out, rir);
     std::printf("wrote %s: %d ch, %d Hz, %.3f s; %s\n", args->out.c_str(), rir.num_channels(),
                 rir.sample_rate, rir.duration_s(), summary.c_str());
@@ -387,8 +389,9 @@ void check_inside(const geometry::Vec3& p, const std::string& what, const data::
   if (render::inside_open_box(p, box)) return;
   const std::string text = what + " " + fmt3(p) + " is outside the field's training box (" +
                            aabb_text(box) +
-                           ", the train microphones +- 1 m); NeRAF replaces such a position by "
-                           "zeros, so the prediction would not describe it";
+                           ", the train microphones +- 1 m, open: a position on a face counts "
+                           "as outside); NeRAF replaces such a position by zeros, so the "
+                           "prediction would not describe it";
   require(allow_outside, text + "; choose a position inside, or pass --allow-outside");
   warn(text);
 }
@@ -418,6 +421,24 @@ void add_render_audio_commands(CLI::App& render) {
   add_render_rir(render);
   add_render_loudness(render);
   add_render_trajectory(render);
+}
+
+void warn_above_full_scale(const io::AudioBuffer& audio, const std::string& out_path,
+                           const std::string& fix) {
+  const float peak = dsp::peak_abs(audio);
+  if (!(peak > 1.0f)) return;
+  std::string ext = std::filesystem::path(out_path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  char level[64];
+  std::snprintf(level, sizeof level, "peak %+.1f dBFS", 20.0 * std::log10(peak));
+  const std::string also = fix.empty() ? "" : ", or " + fix;
+  warn(out_path + ": " + level + " exceeds full scale; " +
+       (ext == ".flac" ? "FLAC holds 24-bit integers, so the samples beyond it are clipped: "
+                         "write a .wav (32-bit float) to keep them" +
+                             also
+                       : "the float WAV keeps them, but playback will clip" +
+                             (fix.empty() ? "" : "; " + fix)));
 }
 
 }  // namespace neraf::cli

@@ -75,4 +75,10 @@ void check_inside(const geometry::Vec3& p, const std::string& what, const data::
 io::AudioBuffer render_rir_from_field(const LoadedField& field, const FieldArgs& field_args,
                                       const AudioPoseArgs& args, std::string* summary);
 
+// A warning naming `out_path` when `audio` goes beyond full scale: a float WAV keeps such samples
+// (playback clips them), a FLAC (24-bit integers) clips them when written. `fix` is the command's
+// own remedy ("pass --normalize"; "" for none).
+void warn_above_full_scale(const io::AudioBuffer& audio, const std::string& out_path,
+                           const std::string& fix);
+
 }  // namespace neraf::cli

@@ -218,10 +218,8 @@ void run_trajectory(const TrajectoryArgs& args) {
   for (auto& ch : result.channels) ch.resize(out_length);
   if (args.normalize) {
     dsp::normalize_peak(result, 0.99f);
-  } else if (dsp::peak_abs(result) > 1.0f) {
-    warn(args.out +
-         ": peak above full scale; the float WAV keeps it, but playback will clip; "
-         "pass --normalize");
+  } else {
+    warn_above_full_scale(result, args.out, "pass --normalize");
   }
   if (view_run) {
     // The frames first: a failure there leaves neither the frames nor the WAV.

@@ -6,14 +6,30 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+#include <string>
+
+#include "neraf/util/log.h"
+#include "neraf/util/number_text.h"
 
 namespace neraf::cli {
 
 void use_all_cores() {
-  if (std::getenv("OMP_NUM_THREADS") != nullptr) return;
   cpu_set_t allowed;
-  const int cores = sched_getaffinity(0, sizeof(allowed), &allowed) == 0 ? CPU_COUNT(&allowed) : 1;
-  torch::set_num_threads(std::max(1, cores));
+  const int cores =
+      std::max(1, sched_getaffinity(0, sizeof(allowed), &allowed) == 0 ? CPU_COUNT(&allowed) : 1);
+  if (const char* env = std::getenv("OMP_NUM_THREADS")) {
+    // The user's count, if it is one --threads would take: 100000 threads crashed in libgomp, 0
+    // or text made LibTorch print raw warnings.
+    std::string count;
+    const std::string why = check_integer(env, 1, max_thread_count(), &count);
+    if (why.empty()) {
+      torch::set_num_threads(std::stoi(count));
+      return;
+    }
+    warn("OMP_NUM_THREADS=" + std::string(env) + ": ignored (" + why + "); using the " +
+         std::to_string(cores) + " cores (--threads sets the count where a command has it)");
+  }
+  torch::set_num_threads(cores);
 }
 
 std::string loaded_blas_library() {

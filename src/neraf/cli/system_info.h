@@ -4,7 +4,8 @@
 namespace neraf::cli {
 
 // LibTorch 1.13 from Debian starts with one intra-op thread; use every core the process may run
-// on unless OMP_NUM_THREADS says otherwise (`--threads` options still override this later).
+// on unless OMP_NUM_THREADS gives a count --threads would accept (another value is ignored with a
+// warning; `--threads` options still override this later).
 void use_all_cores();
 
 // "neraf 0.1.0" plus LibTorch version, thread count and the BLAS library actually loaded.

@@ -223,12 +223,15 @@ std::string lower(std::string s) {
 
 std::string read_name(const std::string& where, const json& j, const std::string& path) {
   const std::string rule =
-      "letters, digits, '-', '_' and '.' only, not starting with '.', at most " +
+      "letters, digits, '-', '_' and '.' only, not starting with '.' nor holding \".tmp-\", at "
+      "most " +
       std::to_string(kMaxPoseNameLength) + " characters";
   if (!j.is_string()) fail(where, path, "must be a string (" + rule + ")");
   const std::string name = j.get<std::string>();
+  // ".tmp-" marks the files neraf is writing (io/atomic_file.h): never a pose's own.
   const bool ok = !name.empty() && name.size() <= kMaxPoseNameLength && name[0] != '.' &&
-                  std::all_of(name.begin(), name.end(), safe_name_char);
+                  std::all_of(name.begin(), name.end(), safe_name_char) &&
+                  name.find(".tmp-") == std::string::npos;
   // The name becomes a file name: anything else could leave the output folder ("../x") or trip
   // up shells.
   if (!ok) fail(where, path, json_quoted(name) + " is not a safe file name; use " + rule);
@@ -286,6 +289,8 @@ json read_json_file(const std::string& path) {
   std::error_code ec;
   require(fs::exists(path, ec), path + ": no such file; check the path");
   require(!fs::is_directory(path, ec), path + ": is a folder, expected a JSON file");
+  // A FIFO or device would block the read (or never end).
+  require(fs::is_regular_file(path, ec), path + ": is not a regular file; expected a JSON file");
   const uintmax_t size = fs::file_size(path, ec);
   require(ec || size <= kMaxFileBytes, path + ": " + std::to_string(size) +
                                            " bytes, too large for a path or pose list (at most " +

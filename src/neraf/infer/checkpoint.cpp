@@ -65,8 +65,13 @@ std::string checkpoint_of_run(const std::string& run_dir, const std::string& che
     return *latest;
   }
   const fs::path parent = fs::absolute(checkpoint, ec).parent_path();
-  require(fs::is_regular_file(checkpoint, ec),
+  require(fs::exists(checkpoint, ec),
           "--checkpoint " + checkpoint + ": no such file; pick one of " + checkpoint_dir(run_dir));
+  require(fs::is_regular_file(checkpoint, ec),
+          "--checkpoint " + checkpoint +
+              ": is not a regular file (a folder, FIFO or device); pick "
+              "one of " +
+              checkpoint_dir(run_dir));
   require(!ends_with(checkpoint, ".calibration.pt"),
           "--checkpoint " + checkpoint +
               ": is a calibration file; give the checkpoint beside it (the same name without "

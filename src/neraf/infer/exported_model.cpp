@@ -136,7 +136,7 @@ ExportReport export_model(const AudioRun& run, const std::string& path,
   io::require_replaceable_file(path);
   const fs::path folder = fs::path(path).has_parent_path() ? fs::path(path).parent_path() : ".";
   io::remove_stale_temporaries(folder.string());
-  const std::string candidate = path + ".tmp-" + std::to_string(static_cast<long long>(getpid()));
+  const std::string candidate = path + io::temporary_suffix();
   const io::RemoveOnSignal remove_on_ctrl_c(candidate);
   try {
     rt::write_model_file(candidate, data);

@@ -52,11 +52,14 @@ nlohmann::json make_data_manifest(const data::ImageSet& images, const std::strin
   const fs::path root = fs::path(images.source).parent_path();
   // The training pictures' pixels, hashed: two rooms with the same image names and poses (two
   // synth runs of different scenes) still differ here.
-  const torch::Tensor pixels = images.train.images.contiguous();
-  char pixel_hash[17];
-  std::snprintf(pixel_hash, sizeof pixel_hash, "%016llx",
-                static_cast<unsigned long long>(io::fnv1a64(std::string_view(
-                    static_cast<const char*>(pixels.data_ptr()), pixels.nbytes()))));
+  const auto pixel_hash = [](const torch::Tensor& images) {
+    const torch::Tensor pixels = images.contiguous();
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx",
+                  static_cast<unsigned long long>(io::fnv1a64(std::string_view(
+                      static_cast<const char*>(pixels.data_ptr()), pixels.nbytes()))));
+    return std::string(hex);
+  };
   auto relative = [&root](const std::vector<std::string>& files) {
     std::vector<std::string> out;
     for (const auto& f : files) out.push_back(fs::path(f).lexically_relative(root).string());
@@ -71,7 +74,8 @@ nlohmann::json make_data_manifest(const data::ImageSet& images, const std::strin
           {"height", k0.height},
           {"width", k0.width},
           {"train_files", relative(images.train.files)},
-          {"train_pixels_fnv1a", pixel_hash},
+          {"train_pixels_fnv1a", pixel_hash(images.train.images)},
+          {"eval_pixels_fnv1a", pixel_hash(images.eval.images)},
           {"eval_files", relative(images.eval.files)},
           {"world_transform", matrix_json(images.world_transform)},
           {"world_scale", images.world_scale},

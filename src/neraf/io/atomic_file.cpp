@@ -21,8 +21,6 @@ namespace fs = std::filesystem;
 namespace neraf::io {
 namespace {
 
-std::string pid_suffix() { return ".tmp-" + std::to_string(static_cast<long long>(::getpid())); }
-
 fs::path parent_or_dot(const fs::path& p) {
   return p.has_parent_path() ? p.parent_path() : fs::path(".");
 }
@@ -94,7 +92,7 @@ void require_creatable(const std::string& path) {
   require(fs::is_directory(folder, ec),
           path + ": " + folder.string() + " is not a usable folder (" +
               (ec ? ec.message() : std::string("not a folder")) + "); choose another output path");
-  const std::string probe = (folder / (".neraf-probe" + pid_suffix())).string();
+  const std::string probe = (folder / (".neraf-probe" + temporary_suffix())).string();
   const int fd = ::open(probe.c_str(), O_CREAT | O_EXCL | O_WRONLY | O_CLOEXEC, 0644);
   require(fd >= 0, path + ": cannot create files in " + folder.string() + " (" +
                        std::strerror(errno) + "); choose a writable output path");
@@ -127,7 +125,7 @@ void write_atomically(const std::string& path,
   const fs::path target(path);
   create_parent(target, path);
   require_replaceable_file(path);
-  const std::string tmp = path + pid_suffix();
+  const std::string tmp = path + temporary_suffix();
   const RemoveOnSignal remove_on_ctrl_c(tmp);
   std::error_code ec;
   try {
@@ -191,7 +189,7 @@ void write_folder_atomically(const std::string& dir,
             dir + ": folder exists and is not empty; choose a new output folder");
   }
   const std::string name = target.filename().string();
-  const fs::path tmp = parent / ("." + name + pid_suffix());
+  const fs::path tmp = parent / ("." + name + temporary_suffix());
   fs::remove_all(tmp, ec);
   fs::create_directory(tmp, ec);
   require(!ec, dir + ": cannot create a temporary folder beside it (" + ec.message() +
@@ -226,7 +224,7 @@ void write_folder_atomically(const std::string& dir,
     return;
   }
   // The old folder is moved aside, not deleted, until the new one is in place.
-  const fs::path old = parent / ("." + name + ".old" + pid_suffix());
+  const fs::path old = parent / ("." + name + ".old" + temporary_suffix());
   if (exists) {
     fs::rename(target, old, ec);
     if (ec) {
@@ -245,8 +243,14 @@ void write_folder_atomically(const std::string& dir,
   if (exists) fs::remove_all(old, ec);
 }
 
+std::string temporary_suffix() {
+  return ".neraf.tmp-" + std::to_string(static_cast<long long>(::getpid()));
+}
+
 int remove_stale_temporaries(const std::string& folder) {
-  static const std::regex kTemporary(R"(\.tmp-([0-9]{1,9}))");
+  // Only names neraf makes: "<name>.neraf.tmp-<pid>", and the runtime's mkstemp file inside an
+  // export ("...neraf.tmp-<pid>.tmp-XXXXXX"). A user's "take.tmp-2024.wav" is no temporary.
+  static const std::regex kTemporary(R"(\.neraf\.tmp-([0-9]{1,9})(\.tmp-[A-Za-z0-9]{6})?$)");
   std::error_code ec;
   if (!fs::is_directory(folder, ec)) return 0;
   int removed = 0;

@@ -46,8 +46,13 @@ void require_replaceable_file(const std::string& path);
 // not after an hour's work). Creates and deletes a probe file; creates nothing else.
 void require_creatable(const std::string& path);
 
-// Removes the temporary files and folders ("*.tmp-<pid>") that processes which no longer exist
-// left in `folder` (a SIGKILL during a write); returns how many. Entries of live processes stay.
+// What neraf appends to the name of a file or folder it is writing: ".neraf.tmp-<pid>" (marked as
+// neraf's own, so remove_stale_temporaries never takes a user's file for one).
+std::string temporary_suffix();
+
+// Removes the temporary files and folders ("*.neraf.tmp-<pid>") that processes which no longer
+// exist left in `folder` (a SIGKILL during a write); returns how many. Entries of live processes
+// stay.
 int remove_stale_temporaries(const std::string& folder);
 
 // fsync of a file or folder (durability of its contents or of its entries); neraf::Error on

@@ -667,7 +667,8 @@ ModelData parse_model(const uint8_t* data, size_t size, const std::string& name)
 }
 
 ModelData read_model_file(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: opening a FIFO would otherwise wait for a writer for ever (fstat refuses it next).
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0)
     throw ModelFileError(NERAF_ERR_IO, path + ": cannot open (" + std::strerror(errno) + ")");
   struct Closer {
