@@ -1,11 +1,12 @@
 // What commands read back from a run's RUN/data.json (infer/run_manifest.h) on any JSON text: the
-// scenes of a multi-scene run (scene_names, find_scene), each scene's "audio" entry
-// (audio_info_from_manifest) and its cameras' intrinsics (intrinsics_from_json). JSON that
-// neraf::parse_json refuses is its documented neraf::Error (fuzz_json_file covers that parser).
-// A damaged manifest is documented as one neraf::Error; what the functions accept must keep their
-// promises (a scene index in range, an audio entry whose sizes agree and whose box is finite and
-// not inside out, intrinsics that are positive and round-trip through intrinsics_json). Anything
-// else is a finding: an exception of another type, a sanitizer report.
+// scenes of a multi-scene run (scene_names, find_scene), the dataset paths (check_data_paths),
+// each scene's "audio" entry (audio_info_from_manifest) and its cameras' intrinsics
+// (intrinsics_from_json). JSON that neraf::parse_json refuses is its documented neraf::Error
+// (fuzz_json_file covers that parser). A damaged manifest is documented as one neraf::Error; what
+// the functions accept must keep their promises (a scene index in range, an audio entry whose
+// sizes agree and whose box is finite and not inside out, intrinsics that are positive and
+// round-trip through intrinsics_json). Anything else is a finding: an exception of another type,
+// a sanitizer report.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -78,6 +79,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     } catch (const neraf::Error&) {
       // The documented outcome for a scene the run does not have.
     }
+  }
+  try {
+    infer::check_data_paths(m, kPath);
+  } catch (const neraf::Error&) {
+    // The documented outcome for a dataset path holding a control character.
   }
   if (infer::is_multiscene(m))
     for (const nlohmann::json& scene : m["scenes"]) check_scene(scene);
