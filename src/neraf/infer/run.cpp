@@ -233,7 +233,8 @@ LoadedRun load_run(const std::string& run_dir, torch::Device device,
           run_dir +
               ": a multi-scene acoustic run has no radiance field of its own; use its "
               "scenes' vision runs (audio.vision_runs in its config.json)");
-  require(run.manifest.value("format", "") == kManifestFormat && run.manifest.contains("num_train"),
+  require(run.manifest.is_object() && run.manifest.value("format", "") == kManifestFormat &&
+              run.manifest.contains("num_train"),
           manifest_path + ": not a neraf run data manifest; re-run neraf train");
   run.checkpoint = checkpoint_of_run(run_dir, checkpoint);
   if (run.config.model.precision == nerf::Precision::bf16 && !nerf::cpu_supports_bf16())

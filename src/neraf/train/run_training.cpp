@@ -279,7 +279,13 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
                 std::to_string(cfg.audio.vision_runs.size()) +
                 "), in the same order; on --resume give them all or none");
     if (dirs.empty() && infer::is_multiscene(old_manifest))
-      for (const auto& sc : old_manifest["scenes"]) dirs.push_back(sc.value("data", std::string()));
+      for (const auto& sc : old_manifest["scenes"]) {
+        require(sc.is_object() && sc.contains("data") && sc["data"].is_string(),
+                options.run_dir +
+                    "/data.json: damaged (a scene without its dataset path); "
+                    "restore it or train a new run");
+        dirs.push_back(sc["data"].get<std::string>());
+      }
     require(dirs.size() == cfg.audio.vision_runs.size(),
             "--data: a multi-scene run needs one --data per --vision-run, in the same order (" +
                 std::to_string(dirs.size()) + " --data, " +
