@@ -81,9 +81,13 @@ expect_exit 0 "$NERAF" synth --preset demo --layout raf --out "$TMP/raf" --seed 
 expect_exit 1 "$NERAF" eval --run "$R" --json "$TMP/x.json" --skip-vision --novel-data "$TMP/raf"
 expect_in "$TMP/err" "is not a soundspaces dataset as the run's is"
 [ ! -e "$TMP/raf/.neraf_cache" ] || fail "a refused --novel-data was left a feature cache"
-# Another room, even at the run's gain, is not new positions of the run's room.
-expect_exit 0 "$NERAF" synth --preset small_dead --layout soundspaces --mics random --mic-count 2 \
+# Another room is not new positions of the run's room: synth will not give it the run's gain,
+# and eval refuses it whatever its gain.
+expect_exit 1 "$NERAF" synth --preset small_dead --layout soundspaces --mics random --mic-count 2 \
   --out "$TMP/other_room" --seed 4 --gain-from "$S" --quiet
+expect_in "$TMP/err" "is another room than preset small_dead"
+expect_exit 0 "$NERAF" synth --preset small_dead --layout soundspaces --mics random --mic-count 2 \
+  --out "$TMP/other_room" --seed 4 --quiet
 expect_exit 1 "$NERAF" eval --run "$R" --json "$TMP/x.json" --skip-vision \
   --novel-data "$TMP/other_room"
 expect_in "$TMP/err" "is another room than the run's data"

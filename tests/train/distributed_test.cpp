@@ -213,8 +213,18 @@ TEST(Distributed, TwoRanksTrainWhatOneProcessTrainsOnTheSameGlobalBatch) {
   const double moved = max_difference(one.params, init);
   const double diff = max_difference(one.params, two.params);
   ASSERT_GT(moved, 1e-3);  // the steps did change the model
-  // Float rounding only: the two halves' gradients are summed in another order.
-  EXPECT_LT(diff, 1e-4 * std::max(1.0, moved)) << "moved " << moved;
+  // Float rounding only: the two halves' gradients are summed in another order. Adam moves a
+  // parameter by about its learning rate whatever the gradient's size, so a component within
+  // rounding of zero can take the other sign on one side: a few elements may differ by a few
+  // learning rates (on this Intel Xeon: 347 of 3.6 M beyond 1e-5, at most 2.4e-4, against all but
+  // 0.05 % for another seed), never the bulk.
+  int64_t elements = 0, apart = 0;
+  for (size_t i = 0; i < one.params.size(); ++i) {
+    elements += one.params[i].numel();
+    apart += (one.params[i] - two.params[i]).abs().gt(1e-5).sum().item<int64_t>();
+  }
+  EXPECT_LT(apart, elements / 1000) << "of " << elements << " elements";
+  EXPECT_LT(diff, 1e-2 * std::max(1.0, moved)) << "moved " << moved;
   for (int s = 0; s < K; ++s)
     EXPECT_NEAR(two.losses[static_cast<size_t>(s)], one.losses[static_cast<size_t>(s)],
                 1e-5 * std::abs(one.losses[static_cast<size_t>(s)]))
@@ -225,8 +235,15 @@ TEST(Distributed, TwoRanksTrainWhatOneProcessTrainsOnTheSameGlobalBatch) {
   const RunResult control = train_ranks(other, 1, K, images, rirs, 25 << 20);
   const double control_diff = max_difference(one.params, control.params);
   EXPECT_GT(control_diff, 100 * diff);
-  std::printf("max |parameter change| %.3g; max |1 process - 2 ranks| %.3g; another seed %.3g\n",
-              moved, diff, control_diff);
+  int64_t control_apart = 0;
+  for (size_t i = 0; i < one.params.size(); ++i)
+    control_apart += (one.params[i] - control.params[i]).abs().gt(1e-5).sum().item<int64_t>();
+  EXPECT_GT(control_apart, elements / 2);
+  std::printf(
+      "max |parameter change| %.3g; max |1 process - 2 ranks| %.3g (%lld of %lld elements beyond "
+      "1e-5); another seed %.3g (%lld)\n",
+      moved, diff, static_cast<long long>(apart), static_cast<long long>(elements), control_diff,
+      static_cast<long long>(control_apart));
 }
 
 TEST(Distributed, WorldSizeMismatchAndBadRankAreClearErrors) {
