@@ -156,11 +156,11 @@ void BM_RenderStftCachedFeature(benchmark::State& state) {
   torch::manual_seed(0);
   AcousticModel m(options_for(preset, bf16));
   GridSampler sampler(m->options().grid);
-  torch::Tensor feature;
+  neraf::acoustic::SceneFeatures feature;
   {
     torch::NoGradGuard g;
     m->eval();
-    feature = m->scene_feature(sampler->grid());
+    feature = m->scene_features(sampler->grid());
   }
   const auto mic = torch::rand({3}, torch::kFloat64), src = torch::rand({3}, torch::kFloat64),
              rot = torch::rand({3}, torch::kFloat64);

@@ -4,7 +4,8 @@
 #      RAF-layout mono room with directional sources; held-out split and new microphone positions
 #   2. the grid ablation (no grid, zero grid, S = 24 / 32 / 64) on the occluded room and on the
 #      furnished / empty pair (S = 16 cannot pass the scene encoder, which halves the grid four
-#      times: BatchNorm would see one voxel)
+#      times: BatchNorm would see one voxel), and the grid read per query (--grid-features local
+#      and both) beside the published global feature
 #   3. few-shot: 25 / 50 / 75 / 100 % of the training RIRs, baselines given the same RIRs
 #   4. cross-modal vision: vision-only vs joint with 10 / 20 / 40 training views
 #   5. the loss study: SC+SL-MSE vs SC+SL-L1 vs MSE
@@ -18,6 +19,8 @@
 #                                     (checks the script end to end in minutes; its numbers mean
 #                                     nothing)
 #   EXPERIMENTS="1 3" scripts/...     only these experiments (the report covers what exists)
+#   E2_ROOMS="occluded" scripts/...   experiment 2 on these of its rooms only (default: all three,
+#                                     occluded raf_furnished raf_empty)
 # Runs are kept in build/experiments/ and skipped when their eval JSON exists, so an interrupted
 # run continues where it stopped (an unfinished training resumes from its last checkpoint).
 set -euo pipefail
@@ -117,10 +120,16 @@ for e in $EXPERIMENTS; do
       ;;
     2)
       say "2/5 the grid ablation (acoustic field alone on a frozen radiance field)"
-      room occluded --preset occluded
-      room raf_furnished --preset furnished_room
-      room raf_empty --preset empty_room
-      for r in occluded raf_furnished raf_empty; do
+      for r in ${E2_ROOMS:-occluded raf_furnished raf_empty}; do
+        case $r in
+          occluded) room occluded --preset occluded ;;
+          raf_furnished) room raf_furnished --preset furnished_room ;;
+          raf_empty) room raf_empty --preset empty_room ;;
+          *)
+            echo "experiments: unknown E2_ROOMS room '$r' (use occluded, raf_furnished, raf_empty)" >&2
+            exit 2
+            ;;
+        esac
         train "v_$r" --data "$OUT/data/$r" --modality vision --seed 1 "${VISION[@]}"
         for s in "${SEEDS[@]}"; do
           a=(--data "$OUT/data/$r" --modality audio --vision-run "$OUT/runs/v_$r" --seed "$s"
@@ -130,8 +139,11 @@ for e in $EXPERIMENTS; do
           train "e2_${r}_grid_zeros_s$s" "${a[@]}" --grid zeros
           train "e2_${r}_S24_s$s" "${a[@]}" --grid-resolution 24
           train "e2_${r}_S64_s$s" "${a[@]}" --grid-resolution 64
+          train "e2_${r}_features_local_s$s" "${a[@]}" --grid-features local
+          train "e2_${r}_features_both_s$s" "${a[@]}" --grid-features both
           abl=$OUT/runs/e2_${r}_grid_none_s$s,$OUT/runs/e2_${r}_grid_zeros_s$s
           abl+=,$OUT/runs/e2_${r}_S24_s$s,$OUT/runs/e2_${r}_S64_s$s
+          abl+=,$OUT/runs/e2_${r}_features_local_s$s,$OUT/runs/e2_${r}_features_both_s$s
           evaluate "e2_${r}_s$s" "e2_${r}_full_s$s" --novel-data "$OUT/data/${r}_novel" \
             --skip-vision --ablation-runs "$abl"
         done

@@ -216,11 +216,15 @@ class Report:
         self.w("## 2. The grid ablation")
         self.w()
         self.w("The acoustic field alone (`--modality audio`, 1500 steps) on one frozen vision run "
-               "per room, identical but for the grid: the full model (sampled grid, S = 32), "
-               "`--grid none`, `--grid zeros`, `--grid-resolution 24` and `64`; scored together "
+               "per room, identical but for the grid: the full model (sampled grid, S = 32, the "
+               "published global feature), `--grid none`, `--grid zeros`, `--grid-resolution 24` "
+               "and `64`, and the grid read per query (ours, issue 13 §5: `--grid-features local`, "
+               "the scene encoder's stem map read at the microphone, at the source and along the "
+               "segment between them; `both`, that and the global feature); scored together "
                "by `neraf eval --ablation-runs` (which refuses runs that trained differently). "
                "The paper's coarsest size, S = 16, cannot pass the scene encoder (it halves the "
-               "grid four times; BatchNorm would see one voxel), so 24 stands in for it.")
+               "grid four times; BatchNorm would see one voxel), so 24 stands in for it. A room "
+               "whose table lacks the `features` rows was run before they existed.")
         self.w()
         for room, title in rooms:
             evals = relabel(self.load("e2_" + room))
@@ -242,7 +246,7 @@ class Report:
                         xs = [(a["ablations"][name] if name in a.get("ablations", {}) else a.get(name, {}))
                               .get(metric) for a in part_of(evals, part)]
                         cells.append(pm([x for x in xs if x is not None], digits_for(metric)))
-                    self.w(f"| {'full (S = 32)' if name == 'neraf' else name} | " + " | ".join(cells) + " |")
+                    self.w(f"| {'full (S = 32, global)' if name == 'neraf' else name} | " + " | ".join(cells) + " |")
                 self.w()
                 self.paired_table(evals, part, "paired_ablations")
             self.plot_ablation(evals, room, title)

@@ -4,6 +4,7 @@
 #include <torch/torch.h>
 
 #include "neraf/acoustic/losses.h"
+#include "neraf/util/error.h"
 
 namespace neraf::acoustic {
 namespace {
@@ -112,6 +113,81 @@ TEST(AcousticModel, RelativeGeometryIsAppendedAfterTheReferenceInputs) {
   EXPECT_TRUE(torch::allclose(y, m->field()->forward(h)));
 }
 
+TEST(AcousticModel, LocalGridFeaturesAreReadPerQueryFromTheStemMap) {
+  torch::manual_seed(6);
+  auto o = small_options(GridMode::kSampled);
+  o.grid_features = GridFeatures::kLocal;
+  o.segment_points = 4;
+  o.nacf.world_to_field = {0.5, 0, 0, -0.25, 0, 0.5, 0, -0.25, 0, 0, 0.5, -0.25};
+  AcousticModel m(o);
+  const int64_t local = 4 * o.resnet.stem_channels;
+  EXPECT_EQ(m->field()->options().in_features(), 163 + local);  // no pooled feature
+  auto grid = torch::rand({7, 32, 32, 32}, torch::requires_grad());
+  const Batch b = random_batch(5, 12);
+  const SceneFeatures f = m->scene_features(grid);
+  EXPECT_FALSE(f.global.defined());
+  ASSERT_EQ(f.volume.sizes(), (std::vector<int64_t>{o.resnet.stem_channels, 16, 16, 16}));
+  // The input: the no-grid layout, then the stem map read along each mic–source segment.
+  const auto h = m->nacf_input(f, m->options().nacf, b.t, b.mic, b.src, b.rot);
+  const auto want = torch::cat(
+      {nacf_input(torch::Tensor(), b.t, 12, b.mic, b.src, b.rot),  // unit box: metres as they are
+       local_geometry_features(f.volume, world_to_grid_input(b.mic, o.nacf.world_to_field),
+                               world_to_grid_input(b.src, o.nacf.world_to_field), 4)},
+      1);
+  EXPECT_TRUE(torch::allclose(h, want));
+  // The gradient reaches the grid and the stem through the per-query features alone; the later
+  // stages are not run.
+  const auto y = m->forward(grid, b.t, b.mic, b.src, b.rot);
+  y.sum().backward();
+  EXPECT_GT(grid.grad().abs().sum().item<float>(), 0.0f);
+  for (const auto& p : m->resnet3d()->named_parameters()) {
+    const bool stem = p.key().rfind("conv1.", 0) == 0 || p.key().rfind("bn1.", 0) == 0;
+    EXPECT_EQ(p.value().grad().defined(), stem) << p.key();
+  }
+  // Two poses of one frame now differ through the grid as well: moving the mic changes the
+  // local part of the input.
+  Batch moved = b;
+  moved.mic = b.mic + 0.3;
+  const auto h2 = m->nacf_input(f, m->options().nacf, moved.t, moved.mic, moved.src, moved.rot);
+  EXPECT_FALSE(torch::allclose(h2.slice(1, 163), h.slice(1, 163)));
+}
+
+TEST(AcousticModel, BothGridFeaturesPutThePooledFeatureFirstAndTheLocalOnesLast) {
+  torch::manual_seed(7);
+  auto o = small_options(GridMode::kSampled);
+  o.grid_features = GridFeatures::kBoth;
+  AcousticModel m(o);
+  const int64_t g = 256, local = 4 * o.resnet.stem_channels;
+  EXPECT_EQ(m->field()->options().in_features(), g + 163 + local);
+  m->eval();
+  torch::NoGradGuard no_grad;
+  const auto grid = torch::rand({7, 32, 32, 32});
+  const SceneFeatures f = m->scene_features(grid);
+  // The pooled feature is ResNet3D's output, as in the global design.
+  torch::manual_seed(7);
+  AcousticModel same_init(o);
+  EXPECT_TRUE(torch::allclose(f.global, same_init->resnet3d()->forward(grid.unsqueeze(0))[0]));
+  const Batch b = random_batch(3, 12);
+  const auto h = m->nacf_input(f, m->options().nacf, b.t, b.mic, b.src, b.rot);
+  EXPECT_TRUE(
+      torch::allclose(h.slice(1, 0, g + 163), nacf_input(f.global, b.t, 12, b.mic, b.src, b.rot)));
+  EXPECT_EQ(h.size(1), g + 163 + local);
+  // Rendering from the features matches the per-frame forward.
+  const auto stft = m->render_stft_with_feature(f, b.mic[0], b.src[0], b.rot[0]);  // [C, F, T]
+  const auto y = m->forward(grid, torch::tensor({3}, torch::kInt64), b.mic.slice(0, 0, 1),
+                            b.src.slice(0, 0, 1), b.rot.slice(0, 0, 1));
+  EXPECT_TRUE(torch::allclose(stft.select(2, 3), y[0], 1e-5, 1e-6));
+}
+
+TEST(AcousticModel, PerQueryGridFeaturesNeedAGrid) {
+  auto o = small_options(GridMode::kNone);
+  o.grid_features = GridFeatures::kLocal;
+  EXPECT_THROW(AcousticModel{o}, Error);
+  EXPECT_EQ(parse_grid_features("both"), GridFeatures::kBoth);
+  EXPECT_EQ(to_string(GridFeatures::kLocal), "local");
+  EXPECT_THROW(parse_grid_features("pooled"), Error);
+}
+
 TEST(AcousticModel, RenderStftMatchesPerFrameForwardInEvalMode) {
   torch::manual_seed(3);
   AcousticModel m(small_options(GridMode::kSampled));
@@ -133,7 +209,7 @@ TEST(AcousticModel, RenderStftMatchesPerFrameForwardInEvalMode) {
                               src.view({1, 3}), rot.view({1, 3}));  // [1, C, F]
     EXPECT_TRUE(torch::allclose(stft.select(2, t), y[0], 1e-5, 1e-6)) << t;
   }
-  const auto feature = m->scene_feature(grid);
+  const auto feature = m->scene_features(grid);
   EXPECT_TRUE(torch::equal(m->render_stft_with_feature(feature, mic, src, rot), stft));
 }
 

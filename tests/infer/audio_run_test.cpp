@@ -6,12 +6,14 @@
 #include <torch/torch.h>
 
 #include <algorithm>
+#include <cmath>
 #include <thread>
 #include <vector>
 
 #include "audio_test_util.h"
 #include "neraf/infer/calibration.h"
 #include "neraf/infer/checkpoint.h"
+#include "neraf/infer/exported_model.h"
 #include "neraf/io/json_file.h"
 #include "neraf/train/trainer.h"
 #include "neraf/util/error.h"
@@ -63,7 +65,7 @@ TEST(AudioRun, ConcurrentQueriesMatchSequentialOnes) {
   io::write_json_atomically(run_dir + "/config.json", to_json(c));
   io::write_json_atomically(run_dir + "/data.json", {{"audio", make_audio_manifest(rirs)}});
   EXPECT_FALSE(load_audio_run(run_dir).calibration().defined());  // saving does not calibrate
-  calibrate_run(run_dir, rirs);  // the stage training ends with
+  calibrate_run(run_dir, rirs);                                   // the stage training ends with
   const AudioRun run = load_audio_run(run_dir);
   ASSERT_TRUE(run.calibration().defined());  // the cpu preset's energy calibration is applied
   EXPECT_FALSE(load_audio_run(run_dir, torch::kCPU, "", nerf::Precision::fp32, false)
@@ -119,6 +121,60 @@ TEST(AudioRun, ConcurrentQueriesMatchSequentialOnes) {
     EXPECT_EQ(got_wave[k], expected_wave) << "thread " << k;
   }
   EXPECT_FALSE(run.model()->is_training());
+}
+
+// A run that reads its grid per query (--grid-features both) answers through the world map of
+// its data manifest, which it needs; the runtime export, which folds one feature per room into
+// NAcF, refuses it.
+TEST(AudioRun, PerQueryGridFeaturesReadTheManifestsWorldMap) {
+  torch::manual_seed(0);
+  const std::string dir = make_temp_dir("local");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  data::ImageSet images = make_image_set();
+  images.world_scale = 0.5;
+  TrainConfig c = tiny_joint_config();
+  c.audio.grid_features = "both";
+  const std::string run_dir = dir + "/run";
+  {
+    auto trainer = train::make_trainer(c, &images, torch::kCPU, &rirs);
+    EXPECT_TRUE(std::isfinite(trainer->step().losses.at("audio_mag_loss")));
+    trainer->save_checkpoint(checkpoint_path(run_dir, 1));
+  }
+  io::write_json_atomically(run_dir + "/config.json", to_json(c));
+  nlohmann::json manifest = {{"audio", make_audio_manifest(rirs)},
+                             {"world_transform", {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}},
+                             {"world_scale", 0.5}};
+  io::write_json_atomically(run_dir + "/data.json", manifest);
+  const data::Rir& r = rirs.rirs[0];
+  const AudioRun run = load_audio_run(run_dir, torch::kCPU, "", nerf::Precision::fp32, false);
+  EXPECT_EQ(run.model()->options().nacf.world_to_field, world_to_field(images));
+  EXPECT_EQ(run.model()->options().nacf.world_to_field[0], 0.5);
+  ASSERT_TRUE(run.scene_features().volume.defined());
+  ASSERT_TRUE(run.scene_features().global.defined());
+  const torch::Tensor a = run.predict_log_stft(r.mic, r.source, r.heading_deg);
+  EXPECT_TRUE(torch::isfinite(a).all().item<bool>());
+  // Another map reads the grid elsewhere: another prediction.
+  manifest["world_transform"][0][3] = 0.7;
+  io::write_json_atomically(run_dir + "/data.json", manifest);
+  const torch::Tensor b = load_audio_run(run_dir, torch::kCPU, "", nerf::Precision::fp32, false)
+                              .predict_log_stft(r.mic, r.source, r.heading_deg);
+  EXPECT_FALSE(torch::allclose(a, b));
+  try {
+    export_model(run, dir + "/model.nrf");
+    FAIL() << "expected neraf::Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--grid-features both"), std::string::npos) << e.what();
+  }
+  manifest.erase("world_scale");
+  io::write_json_atomically(run_dir + "/data.json", manifest);
+  try {
+    load_audio_run(run_dir);
+    FAIL() << "expected neraf::Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("data.json: its world_transform / world_scale"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

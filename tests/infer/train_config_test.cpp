@@ -125,6 +125,7 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
   f.decay_loss = 0.25;
   f.audio_loss = "sc_sll1";
   f.grid_resolution = 16;
+  f.grid_features = "both";
   f.no_relative_geometry = true;
   for (Modality m : {Modality::vision, Modality::joint}) {
     const TrainConfig c = resolve("cpu", m, f);
@@ -140,6 +141,7 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
     EXPECT_EQ(c.audio.decay_weight, 0.25);
     EXPECT_EQ(c.audio.loss, "sc_sll1");
     EXPECT_EQ(c.audio.grid_resolution, 16);
+    EXPECT_EQ(c.audio.grid_features, "both");
     EXPECT_FALSE(c.audio.relative_geometry);
   }
   // Unset flags keep the preset's values.
@@ -152,6 +154,7 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
   EXPECT_TRUE(cpu.audio.relative_geometry);
   EXPECT_EQ(cpu.audio.loss, "sc_slmse");
   EXPECT_EQ(cpu.audio.grid_resolution, 32);
+  EXPECT_EQ(cpu.audio.grid_features, "global");  // the published design
   EXPECT_EQ(resolve("paper", Modality::joint).audio.grid_resolution, 128);
   EXPECT_EQ(resolve("paper", Modality::joint).seed, 42u);
 }
@@ -300,6 +303,24 @@ TEST(TrainConfig, GridResolutionMustPassTheSceneEncoder) {
   c.audio.grid_resolution = 16;
   c.audio.grid = "none";  // no encoder
   EXPECT_NO_THROW(validate(c, "config.json"));
+}
+
+TEST(TrainConfig, PerQueryGridFeaturesNeedAGridAndRoundTrip) {
+  TrainConfig c = train_preset("cpu");
+  c.modality = Modality::joint;
+  c.audio.grid_features = "local";
+  EXPECT_NO_THROW(validate(c, "config.json"));
+  EXPECT_EQ(train_config_from_json(to_json(c), "config.json").audio.grid_features, "local");
+  c.audio.grid = "none";
+  EXPECT_THROW(validate(c, "config.json"), Error);
+  c.audio.grid = "zeros";
+  EXPECT_NO_THROW(validate(c, "config.json"));
+  c.audio.grid_features = "pooled";
+  EXPECT_THROW(validate(c, "config.json"), Error);
+  // A config.json written before the key existed is the published design.
+  nlohmann::json j = to_json(train_preset("cpu"));
+  j["audio"].erase("grid_features");
+  EXPECT_EQ(train_config_from_json(j, "config.json").audio.grid_features, "global");
 }
 
 // A config.json edited to a million threads is refused as the flag is (4 x the cores at most).

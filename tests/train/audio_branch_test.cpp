@@ -187,8 +187,10 @@ TEST(AudioBranch, MultiSceneStepsOverBothScenesAndResumesExactly) {
       fields.emplace_back(c.model, 4, field_seed + k);  // two different frozen fields
       for (auto& p : fields.back()->parameters()) p.set_requires_grad(false);
     }
-    t->add_branch(std::make_unique<AudioBranch>(c, std::vector<const data::RirSet*>{&a, &b}, fields,
-                                                /*frozen_field=*/true, torch::kCPU));
+    t->add_branch(std::make_unique<AudioBranch>(
+        c, std::vector<const data::RirSet*>{&a, &b}, fields,
+        std::vector<acoustic::WorldToField>(2, acoustic::kIdentityWorldToField),
+        /*frozen_field=*/true, torch::kCPU));
     return t;
   };
   auto t = make(7);
@@ -213,6 +215,7 @@ TEST(AudioBranch, MultiSceneStepsOverBothScenesAndResumesExactly) {
   // A one-scene branch refuses the two-scene checkpoint, naming the count.
   auto one = std::make_unique<Trainer>(c, torch::kCPU);
   one->add_branch(std::make_unique<AudioBranch>(c, a, nerf::NerfactoModel(c.model, 4, 7),
+                                                acoustic::kIdentityWorldToField,
                                                 /*frozen_field=*/true, torch::kCPU));
   try {
     one->load_checkpoint(path);
@@ -220,6 +223,38 @@ TEST(AudioBranch, MultiSceneStepsOverBothScenesAndResumesExactly) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("trained on 2 scene(s)"), std::string::npos) << e.what();
   }
+}
+
+// Multi-scene with the grid read per query: each scene's positions reach its own grid through
+// its own world map.
+TEST(AudioBranch, MultiScenePerQueryFeaturesUseEachScenesWorldMap) {
+  torch::manual_seed(0);
+  const std::string dir = make_temp_dir("multilocal");
+  const data::RirSet a = tiny_rir_set(dir + "/a");
+  const data::RirSet b = tiny_rir_set(dir + "/b", /*move_a_point=*/true);
+  TrainConfig c = tiny_joint_config();
+  c.modality = infer::Modality::audio;
+  c.audio.grid_features = "local";
+  const acoustic::WorldToField shifted = {0.5, 0, 0, 0.3, 0, 0.5, 0, 0, 0, 0, 0.5, -0.2};
+  auto first_loss = [&](const acoustic::WorldToField& second_map) {
+    torch::manual_seed(11);
+    auto t = std::make_unique<Trainer>(c, torch::kCPU);
+    std::vector<nerf::NerfactoModel> fields;
+    for (uint64_t k = 0; k < 2; ++k) {
+      fields.emplace_back(c.model, 4, 7 + k);
+      for (auto& p : fields.back()->parameters()) p.set_requires_grad(false);
+    }
+    t->add_branch(std::make_unique<AudioBranch>(
+        c, std::vector<const data::RirSet*>{&a, &b}, fields,
+        std::vector<acoustic::WorldToField>{acoustic::kIdentityWorldToField, second_map},
+        /*frozen_field=*/true, torch::kCPU));
+    const StepResult r = t->step();
+    EXPECT_TRUE(std::isfinite(r.losses.at("audio_mag_loss")));
+    return r.losses.at("audio_mag_loss");
+  };
+  const double same = first_loss(acoustic::kIdentityWorldToField);
+  EXPECT_DOUBLE_EQ(same, first_loss(acoustic::kIdentityWorldToField));  // deterministic
+  EXPECT_NE(same, first_loss(shifted));
 }
 
 }  // namespace

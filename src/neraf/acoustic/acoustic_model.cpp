@@ -25,6 +25,25 @@ std::string to_string(GridMode mode) {
   return "sampled";
 }
 
+GridFeatures parse_grid_features(const std::string& name) {
+  if (name == "global") return GridFeatures::kGlobal;
+  if (name == "local") return GridFeatures::kLocal;
+  if (name == "both") return GridFeatures::kBoth;
+  throw Error("acoustic grid_features: unknown value '" + name + "': use global, local or both");
+}
+
+std::string to_string(GridFeatures features) {
+  switch (features) {
+    case GridFeatures::kGlobal:
+      return "global";
+    case GridFeatures::kLocal:
+      return "local";
+    case GridFeatures::kBoth:
+      return "both";
+  }
+  return "global";
+}
+
 AcousticModelOptions acoustic_preset(const std::string& name, int64_t n_channels, int64_t n_freq,
                                      int64_t max_len) {
   AcousticModelOptions o;
@@ -57,16 +76,24 @@ AcousticModelOptions acoustic_preset(const std::string& name, int64_t n_channels
 
 AcousticModelImpl::AcousticModelImpl(AcousticModelOptions options) : options_(std::move(options)) {
   require(options_.max_len >= 2, "audio max_len: must be at least 2 frames");
+  require(options_.segment_points >= 1, "acoustic segment_points: must be at least 1");
+  const bool local = options_.grid_features != GridFeatures::kGlobal;
   if (options_.grid_mode == GridMode::kNone) {
+    require(!local, "acoustic grid_features " + to_string(options_.grid_features) +
+                        ": needs a grid (grid mode none has none)");
     options_.nacf.grid_features = 0;
+    options_.nacf.local_features = 0;
   } else {
     resnet3d_ = register_module("resnet3d", ResNet3d(options_.resnet));
-    options_.nacf.grid_features = resnet3d_->out_features();
+    options_.nacf.grid_features =
+        options_.grid_features == GridFeatures::kLocal ? 0 : resnet3d_->out_features();
+    // At the mic, at the source, mean and max along the segment (local_geometry.h).
+    options_.nacf.local_features = local ? 4 * options_.resnet.stem_channels : 0;
   }
   field_ = register_module("field", Nacf(options_.nacf));
 }
 
-torch::Tensor AcousticModelImpl::scene_feature(const torch::Tensor& grid) {
+SceneFeatures AcousticModelImpl::scene_features(const torch::Tensor& grid) {
   if (options_.grid_mode == GridMode::kNone) return {};
   const int64_t s = options_.grid.resolution;
   torch::Tensor input;
@@ -79,22 +106,44 @@ torch::Tensor AcousticModelImpl::scene_feature(const torch::Tensor& grid) {
                 "AcousticModel: grid must be [", options_.resnet.in_channels, ", S, S, S]");
     input = grid.unsqueeze(0);
   }
-  return resnet3d_->forward(input).squeeze(0);  // [G]
+  if (options_.grid_features == GridFeatures::kGlobal)
+    return {resnet3d_->forward(input).squeeze(0), {}};  // [G]
+  if (options_.grid_features == GridFeatures::kLocal)
+    return {{}, resnet3d_->stem(input).squeeze(0)};  // [L, S', S', S']; the rest is unused
+  auto [stem, pooled] = resnet3d_->forward_with_stem(input);
+  return {pooled.squeeze(0), stem.squeeze(0)};  // [G], [L, S', S', S']
 }
 
-torch::Tensor AcousticModelImpl::forward_with_feature(const torch::Tensor& feature,
+torch::Tensor AcousticModelImpl::nacf_input(const SceneFeatures& features, const NacfOptions& scene,
+                                            const torch::Tensor& t, const torch::Tensor& mic_m,
+                                            const torch::Tensor& src_m,
+                                            const torch::Tensor& rot) const {
+  torch::Tensor local;
+  if (options_.nacf.local_features > 0) {
+    TORCH_CHECK(features.volume.defined(),
+                "AcousticModel: per-query grid features need the "
+                "stem map (scene_features of this model)");
+    local =
+        local_geometry_features(features.volume, world_to_grid_input(mic_m, scene.world_to_field),
+                                world_to_grid_input(src_m, scene.world_to_field),
+                                options_.segment_points);  // [B, 4L]
+  }
+  return acoustic::nacf_input(scene, features.global, t, options_.max_len, mic_m, src_m, rot,
+                              local);
+}
+
+torch::Tensor AcousticModelImpl::forward_with_feature(const SceneFeatures& features,
                                                       const torch::Tensor& t,
                                                       const torch::Tensor& mic_m,
                                                       const torch::Tensor& src_m,
                                                       const torch::Tensor& rot) const {
-  return field_->forward(nacf_input(options_.nacf, feature, t, options_.max_len, mic_m, src_m,
-                                    rot));  // [B, C, F]
+  return field_->forward(nacf_input(features, options_.nacf, t, mic_m, src_m, rot));  // [B, C, F]
 }
 
 torch::Tensor AcousticModelImpl::forward(const torch::Tensor& grid, const torch::Tensor& t,
                                          const torch::Tensor& mic_m, const torch::Tensor& src_m,
                                          const torch::Tensor& rot) {
-  return forward_with_feature(scene_feature(grid), t, mic_m, src_m, rot);
+  return forward_with_feature(scene_features(grid), t, mic_m, src_m, rot);
 }
 
 namespace {
@@ -119,7 +168,7 @@ torch::Tensor pose_row(const torch::Tensor& x, const char* name) {
 
 }  // namespace
 
-torch::Tensor AcousticModelImpl::render_stft_with_feature(const torch::Tensor& feature,
+torch::Tensor AcousticModelImpl::render_stft_with_feature(const SceneFeatures& features,
                                                           const torch::Tensor& mic_m,
                                                           const torch::Tensor& src_m,
                                                           const torch::Tensor& rot) const {
@@ -130,15 +179,15 @@ torch::Tensor AcousticModelImpl::render_stft_with_feature(const torch::Tensor& f
   const auto mic = pose_row(mic_m, "mic").expand({n, 3});
   const auto src = pose_row(src_m, "source").expand({n, 3});
   const auto r = pose_row(rot, "rot").expand({n, 3});
-  const auto out = forward_with_feature(feature, t, mic, src, r);  // [T, C, F]
-  return out.permute({1, 2, 0}).contiguous();                      // [C, F, T]
+  const auto out = forward_with_feature(features, t, mic, src, r);  // [T, C, F]
+  return out.permute({1, 2, 0}).contiguous();                       // [C, F, T]
 }
 
 torch::Tensor AcousticModelImpl::render_stft(const torch::Tensor& grid, const torch::Tensor& mic_m,
                                              const torch::Tensor& src_m, const torch::Tensor& rot) {
   torch::NoGradGuard no_grad;
   EvalScope eval(*this);
-  return render_stft_with_feature(scene_feature(grid), mic_m, src_m, rot);
+  return render_stft_with_feature(scene_features(grid), mic_m, src_m, rot);
 }
 
 }  // namespace neraf::acoustic

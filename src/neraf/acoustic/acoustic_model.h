@@ -9,6 +9,14 @@
 //             information, same network
 //   kNone     no ResNet3D; NAcF takes the no-grid input order [mic, source, time, rot] (163)
 //
+// Grid features (how the encoded grid reaches NAcF; kSampled and kZeros):
+//   kGlobal   the pooled feature, one vector per room (the published design, default)
+//   kLocal    geometry per query instead: ResNet3D's stem map (before the max pool, ⌈S/2⌉³)
+//             read at the microphone, at the source and along the segment between them
+//             (local_geometry.h), 4 × stem channels per query; NAcF's input in the no-grid
+//             order with these appended (ResNet3D's later stages are then not run)
+//   kBoth     both: the pooled feature and the per-query features
+//
 // Presets (acoustic_preset): "paper" = grid 128³, ResNet3D-50/layer3 (1024 features), NAcF
 // 1187→5096→2048→1024→1024→512, 4096 cells per grid update; "cpu" = grid 32³ with 1024 cells per
 // update, small BasicBlock ResNet3D (256 features), NAcF 5×512 (the paper's text) with the
@@ -32,11 +40,25 @@ enum class GridMode { kSampled, kZeros, kNone };
 GridMode parse_grid_mode(const std::string& name);  // "sampled" | "zeros" | "none"
 std::string to_string(GridMode mode);
 
+enum class GridFeatures { kGlobal, kLocal, kBoth };
+GridFeatures parse_grid_features(const std::string& name);  // "global" | "local" | "both"
+std::string to_string(GridFeatures features);
+
+// What NAcF reads of one room's encoded grid.
+struct SceneFeatures {
+  torch::Tensor global;  // [G] pooled ResNet3D feature; undefined for kNone and kLocal
+  torch::Tensor volume;  // [L, S', S', S'] ResNet3D's stem map; undefined for kGlobal and kNone
+};
+
 struct AcousticModelOptions {
   GridSamplerOptions grid;
   ResNet3dOptions resnet = resnet3d_cpu_options();
-  NacfOptions nacf = nacf_cpu_options(2, 257);  // grid_features is set from resnet by the model
+  // grid_features and local_features are set from resnet by the model; the box and the world
+  // map from the data (infer::audio_model_options).
+  NacfOptions nacf = nacf_cpu_options(2, 257);
   GridMode grid_mode = GridMode::kSampled;
+  GridFeatures grid_features = GridFeatures::kGlobal;
+  int64_t segment_points = 8;  // points read inside the mic–source segment (kLocal, kBoth)
   int64_t max_len = 78;  // frames per RIR (time normalisation t/(max_len − 1)); set from the data
 };
 
@@ -48,9 +70,10 @@ class AcousticModelImpl : public torch::nn::Module {
  public:
   explicit AcousticModelImpl(AcousticModelOptions options);
 
-  // Scene feature from the grid: [7, S, S, S] → [G] (kSampled), zeros grid → [G] (kZeros; `grid`
-  // may be undefined), undefined tensor (kNone). Runs ResNet3D in the module's current mode.
-  torch::Tensor scene_feature(const torch::Tensor& grid);
+  // What NAcF reads of the grid [7, S, S, S]: the pooled feature and/or the stem map, as the
+  // grid features ask (kZeros: of an all-zero grid; `grid` may be undefined there; kNone: none).
+  // Runs ResNet3D in the module's current mode.
+  SceneFeatures scene_features(const torch::Tensor& grid);
 
   // grid: [7, S, S, S] (ignored for kZeros/kNone; may be undefined there); t: [B] int64 frame
   // indices; mic_m, src_m: [B, 3] positions in metres (float64 advised; normalised here by
@@ -60,10 +83,15 @@ class AcousticModelImpl : public torch::nn::Module {
   torch::Tensor forward(const torch::Tensor& grid, const torch::Tensor& t,
                         const torch::Tensor& mic_m, const torch::Tensor& src_m,
                         const torch::Tensor& rot);
-  // Same with a precomputed scene feature ([G], or undefined for kNone). Runs NAcF only, which
-  // has no BatchNorm or dropout: the same in either mode, and reads no module state but the
-  // parameters.
-  torch::Tensor forward_with_feature(const torch::Tensor& feature, const torch::Tensor& t,
+  // NAcF's input [B, in_features] for positions of the room `scene` describes (its box and world
+  // map; options().nacf for a one-scene model): nacf_input with the per-query features read
+  // from features.volume when the model uses them.
+  torch::Tensor nacf_input(const SceneFeatures& features, const NacfOptions& scene,
+                           const torch::Tensor& t, const torch::Tensor& mic_m,
+                           const torch::Tensor& src_m, const torch::Tensor& rot) const;
+  // forward with precomputed scene features. Runs NAcF only, which has no BatchNorm or dropout:
+  // the same in either mode, and reads no module state but the parameters.
+  torch::Tensor forward_with_feature(const SceneFeatures& features, const torch::Tensor& t,
                                      const torch::Tensor& mic_m, const torch::Tensor& src_m,
                                      const torch::Tensor& rot) const;
 
@@ -72,10 +100,10 @@ class AcousticModelImpl : public torch::nn::Module {
   // No autograd, ResNet3D and NAcF in eval mode (the previous mode is restored), one batch of T.
   torch::Tensor render_stft(const torch::Tensor& grid, const torch::Tensor& mic_m,
                             const torch::Tensor& src_m, const torch::Tensor& rot);
-  // Same from a scene feature computed once (in eval mode) for many RIRs: the inference query.
+  // Same from scene features computed once (in eval mode) for many RIRs: the inference query.
   // NAcF only, so no train/eval switch is needed and none is made; with the thread-local
   // NoGradGuard it touches no shared state and may run from several threads at once.
-  torch::Tensor render_stft_with_feature(const torch::Tensor& feature, const torch::Tensor& mic_m,
+  torch::Tensor render_stft_with_feature(const SceneFeatures& features, const torch::Tensor& mic_m,
                                          const torch::Tensor& src_m,
                                          const torch::Tensor& rot) const;
 

@@ -130,13 +130,22 @@ torch::Tensor nacf_input(const torch::Tensor& grid_feature, const torch::Tensor&
 
 torch::Tensor nacf_input(const NacfOptions& options, const torch::Tensor& grid_feature,
                          const torch::Tensor& t, int64_t max_len, const torch::Tensor& mic_m,
-                         const torch::Tensor& src_m, const torch::Tensor& rot) {
-  const torch::Tensor h = nacf_input(grid_feature, t, max_len,
-                                     normalize_to_box(mic_m, options.box_min, options.box_max),
-                                     normalize_to_box(src_m, options.box_min, options.box_max), rot,
-                                     options.position_max_freq_exp);  // [B, G + 163]
-  if (!options.relative_geometry) return h;
-  return torch::cat({h, encode_relative_geometry(mic_m, src_m, rot, options.extent_m())}, 1);
+                         const torch::Tensor& src_m, const torch::Tensor& rot,
+                         const torch::Tensor& local) {
+  std::vector<torch::Tensor> parts = {nacf_input(
+      grid_feature, t, max_len, normalize_to_box(mic_m, options.box_min, options.box_max),
+      normalize_to_box(src_m, options.box_min, options.box_max), rot,
+      options.position_max_freq_exp)};  // [B, G + 163]
+  if (options.relative_geometry)
+    parts.push_back(encode_relative_geometry(mic_m, src_m, rot, options.extent_m()));  // [B, 22]
+  if (options.local_features > 0) {
+    TORCH_CHECK(local.defined() && local.dim() == 2 && local.size(0) == t.size(0) &&
+                    local.size(1) == options.local_features,
+                "nacf_input: local features must be [", t.size(0), ", ", options.local_features,
+                "], got ", local.defined() ? local.sizes() : torch::IntArrayRef{});
+    parts.push_back(local.to(torch::kFloat32));
+  }
+  return parts.size() == 1 ? parts.front() : torch::cat(parts, 1);
 }
 
 NacfImpl::NacfImpl(NacfOptions options) : options_(std::move(options)) {

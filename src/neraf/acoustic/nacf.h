@@ -42,6 +42,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "neraf/acoustic/local_geometry.h"
+
 namespace neraf::acoustic {
 
 constexpr int64_t kTimeEncodingDim = 21;
@@ -67,12 +69,18 @@ struct NacfOptions {
   // makes metres and normalised coordinates the same.
   std::array<double, 3> box_min{0, 0, 0};
   std::array<double, 3> box_max{1, 1, 1};
+  // Geometry per query (local_geometry.h; --grid-features local|both): how many features each
+  // query appends after everything else (4·L of an L-channel volume; 0 = the published design),
+  // and the map from the positions' metres into the radiance field's frame that reads them.
+  int64_t local_features = 0;
+  WorldToField world_to_field = kIdentityWorldToField;
 
   std::array<double, 3> extent_m() const {
     return {box_max[0] - box_min[0], box_max[1] - box_min[1], box_max[2] - box_min[2]};
   }
   int64_t in_features() const {
-    return grid_features + kPoseEncodingDim + (relative_geometry ? kRelativeGeometryDim : 0);
+    return grid_features + kPoseEncodingDim + (relative_geometry ? kRelativeGeometryDim : 0) +
+           local_features;
   }
 };
 
@@ -117,11 +125,12 @@ torch::Tensor nacf_input(const torch::Tensor& grid_feature, const torch::Tensor&
 
 // Every input a Nacf built with `options` expects, from positions in METRES (mic_m, src_m: [B, 3]):
 // nacf_input of the positions normalised by options' box (normalize_to_box) with its position
-// frequencies, then (options.relative_geometry) encode_relative_geometry of the metres →
-// [B, options.in_features()].
+// frequencies, then (options.relative_geometry) encode_relative_geometry of the metres, then
+// (options.local_features > 0) `local`, [B, local_features] → [B, options.in_features()].
 torch::Tensor nacf_input(const NacfOptions& options, const torch::Tensor& grid_feature,
                          const torch::Tensor& t, int64_t max_len, const torch::Tensor& mic_m,
-                         const torch::Tensor& src_m, const torch::Tensor& rot);
+                         const torch::Tensor& src_m, const torch::Tensor& rot,
+                         const torch::Tensor& local = {});
 
 class NacfImpl : public torch::nn::Module {
  public:

@@ -125,19 +125,39 @@ ResNet3dImpl::ResNet3dImpl(ResNet3dOptions options) : options_(std::move(options
   }
 }
 
-torch::Tensor ResNet3dImpl::feature_map(const torch::Tensor& x) {
+namespace {
+
+torch::Tensor global_average(const torch::Tensor& map) {
+  return torch::adaptive_avg_pool3d(map, {1, 1, 1}).flatten(1);  // [B, C]
+}
+
+}  // namespace
+
+torch::Tensor ResNet3dImpl::stem(const torch::Tensor& x) {
   TORCH_CHECK(x.dim() == 5 && x.size(1) == options_.in_channels, "ResNet3d: expected [B, ",
               options_.in_channels, ", S, S, S], got ", x.sizes());
-  auto h = torch::relu(bn1(conv1(x)));
+  return torch::relu(bn1(conv1(x)));
+}
+
+std::pair<torch::Tensor, torch::Tensor> ResNet3dImpl::stem_and_map(const torch::Tensor& x) {
+  const auto s = stem(x);
+  auto h = s;
   if (options_.stem_max_pool) {
     h = torch::max_pool3d(h, /*kernel_size=*/3, /*stride=*/2, /*padding=*/1);
   }
   for (auto& stage : layers_) h = stage->forward(h);
-  return h;
+  return {s, h};
+}
+
+torch::Tensor ResNet3dImpl::feature_map(const torch::Tensor& x) { return stem_and_map(x).second; }
+
+std::pair<torch::Tensor, torch::Tensor> ResNet3dImpl::forward_with_stem(const torch::Tensor& x) {
+  auto [stem, map] = stem_and_map(x);
+  return {stem, global_average(map)};
 }
 
 torch::Tensor ResNet3dImpl::forward(const torch::Tensor& x) {
-  return torch::adaptive_avg_pool3d(feature_map(x), {1, 1, 1}).flatten(1);  // [B, C]
+  return global_average(feature_map(x));
 }
 
 }  // namespace neraf::acoustic

@@ -33,6 +33,7 @@
 #include <torch/types.h>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace neraf::acoustic {
@@ -86,11 +87,17 @@ class ResNet3dImpl : public torch::nn::Module {
   torch::Tensor forward(const torch::Tensor& x);
   // The map before pooling: [B, out_features, S', S', S'] (S' = 8 for the paper preset at 128³).
   torch::Tensor feature_map(const torch::Tensor& x);
+  // The stem's map (conv1 → BN → ReLU, before the max pool): [B, stem_channels, ⌈S/2⌉³].
+  torch::Tensor stem(const torch::Tensor& x);
+  // One pass for both uses: {stem(x), forward(x)}.
+  std::pair<torch::Tensor, torch::Tensor> forward_with_stem(const torch::Tensor& x);
 
   int64_t out_features() const { return resnet3d_out_features(options_); }
   const ResNet3dOptions& options() const { return options_; }
 
  private:
+  std::pair<torch::Tensor, torch::Tensor> stem_and_map(const torch::Tensor& x);  // {stem, map}
+
   ResNet3dOptions options_;
   torch::nn::Conv3d conv1{nullptr};
   torch::nn::BatchNorm3d bn1{nullptr};

@@ -127,6 +127,7 @@ nlohmann::json score_audio(const infer::AudioField& run, const std::vector<Ablat
       abl[a.label] = eval::to_json(m.summary);
       abl[a.label]["run"] = a.dir;
       abl[a.label]["grid"] = a.run.run().config.audio.grid;
+      abl[a.label]["grid_features"] = a.run.run().config.audio.grid_features;
       abl[a.label]["grid_resolution"] = a.run.run().config.audio.grid_resolution;
       abl[a.label]["relative_geometry"] = a.run.run().config.audio.relative_geometry;
       abl[a.label]["loss"] = a.run.run().config.audio.loss;
@@ -484,9 +485,8 @@ void register_eval(CLI::App& app) {
       "the energy calibration and early/late balance fitted on its training RIRs, and\n"
       "\"neraf_uncalibrated\" without, as the linear baseline is rendered (each row states its\n"
       "post-processing). --ablation-runs must have trained exactly as --run but for audio.grid,\n"
-      "audio.grid_resolution, audio.relative_geometry or audio.loss (same modality, preset, steps, "
-      "seed,\n"
-      "data; else refused). Baselines:\n"
+      "audio.grid_features, audio.grid_resolution, audio.relative_geometry or audio.loss (same\n"
+      "modality, preset, steps, seed, data; else refused). Baselines:\n"
       "nearest = the measured RIR of the closest training mic with the same heading and source;\n"
       "linear = inverse-distance blend of the 2-4 closest such training RIRs' magnitudes +\n"
       "Griffin-Lim. Side-by-side GT | prediction PNGs (images: eval_*.png; audio: audio_*.png\n"

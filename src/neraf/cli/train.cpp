@@ -30,6 +30,7 @@ struct TrainArgs {
   std::vector<std::string> data;  // one per scene (2+ make a multi-scene audio run)
   std::string modality = "joint";
   std::string grid = "sampled";
+  std::string grid_features = "global";
   std::vector<std::string> vision_run;
   double audio_fraction = 1.0;
   int64_t audio_start = -2;
@@ -171,6 +172,14 @@ void register_train(CLI::App& app) {
                       "paper's ablations")
           ->check(CLI::IsMember({"sampled", "none", "zeros"}))
           ->capture_default_str();
+  CLI::Option* grid_features =
+      cmd->add_option("--grid-features", args->grid_features,
+                      "How the acoustic field reads the encoded grid: global (one pooled vector "
+                      "per room, NeRAF), local (the scene encoder's volume read at the "
+                      "microphone, at the source and along the segment between them, per query) "
+                      "or both")
+          ->check(CLI::IsMember({"global", "local", "both"}))
+          ->capture_default_str();
   args->grid_resolution_opt =
       cmd->add_option("--grid-resolution", args->grid_resolution,
                       "S: the acoustic grid's cells per side (default: the preset's, cpu 32, "
@@ -270,9 +279,9 @@ void register_train(CLI::App& app) {
                       "With --world-size: the network interface for the ranks' traffic (e.g. "
                       "eth0; default: the address this host's name resolves to)");
 
-  cmd->callback([args, data, preset, steps, seed, threads, rays, precision, grid, fraction,
-                 vision_run, audio_start, decay_loss, no_relative, save_every, world_size, rank,
-                 master, dist_timeout, dist_interface]() {
+  cmd->callback([args, data, preset, steps, seed, threads, rays, precision, grid, grid_features,
+                 fraction, vision_run, audio_start, decay_loss, no_relative, save_every, world_size,
+                 rank, master, dist_timeout, dist_interface]() {
     if (args->world_size == 1)
       for (CLI::Option* o : {rank, master, dist_timeout, dist_interface})
         require(o->count() == 0, o->get_name() + ": only with --world-size N (N > 1)");
@@ -299,6 +308,7 @@ void register_train(CLI::App& app) {
     if (rays->count()) flags.rays = args->rays;
     if (precision->count()) flags.precision = nerf::parse_precision(args->precision, "--precision");
     flags.grid = args->grid;
+    if (grid_features->count()) flags.grid_features = args->grid_features;
     flags.audio_fraction = args->audio_fraction;
     if (audio_start->count()) flags.audio_start_step = args->audio_start;
     if (decay_loss->count()) flags.decay_loss = args->decay_loss;
@@ -322,14 +332,16 @@ void register_train(CLI::App& app) {
                 "same order");
 
     if (flags.modality == infer::Modality::vision)
-      for (CLI::Option* o : {grid, args->grid_resolution_opt, fraction, audio_start, decay_loss,
-                             args->audio_loss_opt, no_relative, args->max_len_opt,
+      for (CLI::Option* o : {grid, grid_features, args->grid_resolution_opt, fraction, audio_start,
+                             decay_loss, args->audio_loss_opt, no_relative, args->max_len_opt,
                              args->cache_dir_opt, args->cache_precision_opt})
         require(o->count() == 0, o->get_name() +
                                      ": sets the acoustic field, which --modality vision does "
                                      "not train; drop it (or train --modality joint)");
     require(args->grid != "none" || args->grid_resolution_opt->count() == 0,
             "--grid-resolution: --grid none has no grid; drop one of them");
+    require(args->grid != "none" || args->grid_features == "global",
+            "--grid-features: --grid none has no grid to read; drop one of them");
     require_cache_folder({"--cache-dir", args->cache_dir}, args->out);
     infer::TrainConfig cfg = infer::resolve_train_config(flags);
     cfg.audio.cache_dir = args->cache_dir;
@@ -364,8 +376,8 @@ void register_train(CLI::App& app) {
               ": no config.json here, so there is no run to resume; drop --resume to start a "
               "new run");
       // The run's own config wins; flags that would change the model are refused.
-      for (CLI::Option* o : {preset, seed, rays, precision, grid, fraction, vision_run, audio_start,
-                             decay_loss, no_relative})
+      for (CLI::Option* o : {preset, seed, rays, precision, grid, grid_features, fraction,
+                             vision_run, audio_start, decay_loss, no_relative})
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json is "
                                      "used); start a new run with --out to change it");

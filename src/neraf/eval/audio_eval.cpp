@@ -405,7 +405,8 @@ std::string first_difference(const nlohmann::json& main, const nlohmann::json& o
 }  // namespace
 
 std::vector<std::string> ablation_knobs() {
-  return {"audio.grid", "audio.grid_resolution", "audio.relative_geometry", "audio.loss"};
+  return {"audio.grid", "audio.grid_features", "audio.grid_resolution", "audio.relative_geometry",
+          "audio.loss"};
 }
 
 std::string training_difference(const nlohmann::json& main_config, const nlohmann::json& main_data,

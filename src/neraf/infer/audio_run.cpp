@@ -116,11 +116,13 @@ void check_same_room_format(const nlohmann::json& manifest, const data::RirSet& 
 
 acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, int64_t channels,
                                                    int64_t n_freq, int64_t max_len,
-                                                   const data::Aabb& audio_aabb) {
+                                                   const data::Aabb& audio_aabb,
+                                                   const acoustic::WorldToField& world_to_field) {
   acoustic::AcousticModelOptions o =
       acoustic::acoustic_preset(config.preset, channels, n_freq, max_len);
   const AudioConfig& a = config.audio;
   o.grid_mode = acoustic::parse_grid_mode(a.grid);
+  o.grid_features = acoustic::parse_grid_features(a.grid_features);
   o.grid.view_directions = acoustic::parse_view_directions(a.view_directions);
   o.resnet.running_stats = a.resnet_batch_norm == "running";
   o.grid.resolution = a.grid_resolution;
@@ -132,6 +134,7 @@ acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, in
   o.nacf.position_max_freq_exp = a.position_max_freq_exp;
   o.nacf.box_min = {audio_aabb.min.x, audio_aabb.min.y, audio_aabb.min.z};
   o.nacf.box_max = {audio_aabb.max.x, audio_aabb.max.y, audio_aabb.max.z};
+  o.nacf.world_to_field = world_to_field;
   return o;
 }
 
@@ -154,7 +157,7 @@ std::vector<int64_t> audio_train_subset(const data::RirSet& rirs, double fractio
 
 torch::Tensor AudioRun::predict_pose(const torch::Tensor& mic_m, const torch::Tensor& src_m,
                                      const torch::Tensor& rot) const {
-  const torch::Tensor raw = model_->render_stft_with_feature(feature_, mic_m, src_m, rot);
+  const torch::Tensor raw = model_->render_stft_with_feature(features_, mic_m, src_m, rot);
   return calibration_.defined() ? acoustic::apply_calibration(raw, calibration_)
                                 : raw;  // [C, F, T]
 }
@@ -205,7 +208,10 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
   out.run_.checkpoint = checkpoint_of_run(run_dir, checkpoint);
   const AudioRunInfo& info = out.info_;
   acoustic::AcousticModelOptions opts =
-      audio_model_options(out.run_.config, info.channels, info.n_freq, info.max_len, info.aabb);
+      audio_model_options(out.run_.config, info.channels, info.n_freq, info.max_len, info.aabb,
+                          out.run_.config.audio.grid_features == "global"
+                              ? acoustic::kIdentityWorldToField  // not read
+                              : world_to_field(out.run_.manifest, manifest_path));
   // Queries run in fp32 unless asked (bf16 training keeps fp32 master weights): the numbers of
   // eval and render then do not depend on the machine, and match an fp32 export.
   opts.nacf.bf16 = precision == nerf::Precision::bf16;
@@ -255,7 +261,7 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
   {
     // The scene feature is computed once: eval-mode ResNet3D on the grid saved at that step.
     torch::NoGradGuard no_grad;
-    out.feature_ = out.model_->scene_feature(grid->grid().detach());
+    out.features_ = out.model_->scene_features(grid->grid().detach());
   }
   return out;
 }

@@ -55,11 +55,14 @@ void check_same_room_format(const nlohmann::json& manifest, const data::RirSet& 
                             const std::string& where);
 
 // The acoustic model options of a run: the preset's (`config.preset`) sized to the data, with the
-// AudioConfig overrides (grid mode, resolution, cells per update, NAcF width, relative geometry)
-// and `audio_aabb` as the box NAcF normalises positions by.
-acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, int64_t channels,
-                                                   int64_t n_freq, int64_t max_len,
-                                                   const data::Aabb& audio_aabb);
+// AudioConfig overrides (grid mode and features, resolution, cells per update, NAcF width,
+// relative geometry), `audio_aabb` as the box NAcF normalises positions by and `world_to_field`
+// as the map of those metres into the radiance field's frame (per-query grid features; from
+// the run's data manifest, world_to_field below).
+acoustic::AcousticModelOptions audio_model_options(
+    const TrainConfig& config, int64_t channels, int64_t n_freq, int64_t max_len,
+    const data::Aabb& audio_aabb,
+    const acoustic::WorldToField& world_to_field = acoustic::kIdentityWorldToField);
 
 // The seeded subset of `rirs.train` used for training (--audio-fraction): all of it for
 // fraction 1, else round(fraction·N) (at least 1) indices drawn without replacement with `seed`,
@@ -86,10 +89,10 @@ class AudioRun final : public AudioField {
                              const torch::Tensor& rot) const;
 
   // What a query reads, for exporting the model: the acoustic model (eval mode; read-only), the
-  // [G] scene feature (undefined for grid mode none) and the [C, F, T] energy gains (undefined
-  // when the run has no calibration).
+  // scene features (acoustic_model.h; none for grid mode none) and the [C, F, T] energy gains
+  // (undefined when the run has no calibration).
   const acoustic::AcousticModel& model() const { return model_; }
-  const torch::Tensor& scene_feature() const { return feature_; }
+  const acoustic::SceneFeatures& scene_features() const { return features_; }
   const torch::Tensor& calibration() const { return calibration_; }
 
  private:
@@ -99,7 +102,7 @@ class AudioRun final : public AudioField {
   int64_t scene_ = 0;  // run_.model is the radiance field (nullptr-free only for vision/joint runs)
   AudioRunInfo info_;
   acoustic::AcousticModel model_{nullptr};  // eval mode from load on; queries only read it
-  torch::Tensor feature_;  // [G] scene feature (eval-mode ResNet3D on the saved grid) or undefined
+  acoustic::SceneFeatures features_;        // eval-mode ResNet3D on the saved grid
   torch::Tensor calibration_;  // [C, F, T] energy gains (acoustic/calibration.h) or undefined
 };
 

@@ -62,6 +62,11 @@ rt::ModelData export_model_data(const AudioRun& run, const ExportOptions& option
   const AudioRunInfo& info = run.info();
   const acoustic::AcousticModelOptions& mo = run.model()->options();
   const acoustic::NacfOptions& no = mo.nacf;
+  require(mo.grid_features == acoustic::GridFeatures::kGlobal,
+          run.run().run_dir + ": trained with --grid-features " +
+              acoustic::to_string(mo.grid_features) +
+              "; the runtime takes the published design (one scene feature per room) only, so "
+              "this run cannot be exported; query it with neraf render / eval --run instead");
   rt::ModelData m;
   m.neraf_version = NERAF_VERSION;
   m.layout = info.layout == data::AudioLayout::raf ? 1 : 0;
@@ -99,7 +104,8 @@ rt::ModelData export_model_data(const AudioRun& run, const ExportOptions& option
             {w.narrow(1, 2 * pos, t), w.narrow(1, 0, 2 * pos), w.narrow(1, 2 * pos + t, rot), rest},
             1);
       } else {  // [g, time, mic, src, rot, relative]: fold the constant feature into the bias
-        const torch::Tensor feature = run.scene_feature().detach().to(torch::kCPU, torch::kFloat64);
+        const torch::Tensor feature =
+            run.scene_features().global.detach().to(torch::kCPU, torch::kFloat64);
         require(feature.defined() && feature.numel() == g,
                 "export: the run's scene feature does not match its model (a neraf bug)");
         b = b + torch::mv(w.narrow(1, 0, g), feature);

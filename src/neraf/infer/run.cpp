@@ -84,6 +84,40 @@ nlohmann::json make_data_manifest(const data::ImageSet& images, const std::strin
           {"eval_camera_to_world", eval_poses}};
 }
 
+namespace {
+
+acoustic::WorldToField world_to_field(const torch::Tensor& transform, double scale) {
+  const torch::Tensor m = (transform.to(torch::kFloat64) * scale).contiguous();  // [3, 4]
+  acoustic::WorldToField out{};
+  std::copy(m.data_ptr<double>(), m.data_ptr<double>() + 12, out.begin());
+  return out;
+}
+
+}  // namespace
+
+acoustic::WorldToField world_to_field(const data::ImageSet& images) {
+  return world_to_field(images.world_transform, images.world_scale);
+}
+
+acoustic::WorldToField world_to_field(const nlohmann::json& manifest, const std::string& where) {
+  const nlohmann::json rows = manifest.value("world_transform", nlohmann::json());
+  const nlohmann::json scale = manifest.value("world_scale", nlohmann::json());
+  bool ok = rows.is_array() && rows.size() == 3 && scale.is_number();
+  acoustic::WorldToField out{};
+  for (size_t r = 0; ok && r < 3; ++r) {
+    ok = rows[r].is_array() && rows[r].size() == 4;
+    for (size_t k = 0; ok && k < 4; ++k) {
+      ok = rows[r][k].is_number() && std::isfinite(rows[r][k].get<double>());
+      if (ok) out[4 * r + k] = rows[r][k].get<double>() * scale.get<double>();
+    }
+  }
+  require(ok && std::isfinite(scale.get<double>()),
+          where +
+              ": its world_transform / world_scale are missing or damaged; re-run neraf "
+              "train (the acoustic field reads the grid through them)");
+  return out;
+}
+
 void check_vision_run_data(const std::string& vision_run, const nlohmann::json& now) {
   const std::string path = run_file(vision_run, "data.json");
   std::error_code ec;

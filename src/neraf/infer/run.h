@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "neraf/acoustic/local_geometry.h"
 #include "neraf/data/image_set.h"
 #include "neraf/infer/run_manifest.h"
 #include "neraf/infer/train_config.h"
@@ -61,6 +62,13 @@ struct LoadedRun {
 // has no checkpoint, or the checkpoint is corrupted / from another config.
 LoadedRun load_run(const std::string& run_dir, torch::Device device = torch::kCPU,
                    const std::string& checkpoint = "");
+
+// The map from the dataset's metres into the radiance field's normalised frame (the RIR positions
+// into the grid, acoustic/local_geometry.h): scale · (R p + t) of the images' normalisation,
+// from an ImageSet or a (one-scene) run data manifest ("world_transform", "world_scale"; a
+// manifest without them is named by `where`).
+acoustic::WorldToField world_to_field(const data::ImageSet& images);
+acoustic::WorldToField world_to_field(const nlohmann::json& manifest, const std::string& where);
 
 // The eval cameras stored in the manifest: c2w [N, 3, 4] (normalised frame) and intrinsics.
 torch::Tensor manifest_eval_poses(const nlohmann::json& manifest);

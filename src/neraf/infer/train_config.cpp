@@ -54,6 +54,7 @@ TrainConfig resolve_train_config(const TrainFlags& f) {
                  std::max<int64_t>(0, (schedule.max_steps - schedule.warmup_start) / 2));
   }
   cfg.audio.grid = f.grid;
+  if (f.grid_features) cfg.audio.grid_features = *f.grid_features;
   if (f.decay_loss) cfg.audio.decay_weight = *f.decay_loss;
   if (f.audio_loss) cfg.audio.loss = *f.audio_loss;
   if (f.grid_resolution) cfg.audio.grid_resolution = *f.grid_resolution;
@@ -105,6 +106,11 @@ void validate(const TrainConfig& c, const std::string& where) {
   const AudioConfig& a = c.audio;
   require(a.grid == "sampled" || a.grid == "none" || a.grid == "zeros",
           where + ".audio.grid: use sampled, none or zeros (--grid)");
+  require(a.grid_features == "global" || a.grid_features == "local" || a.grid_features == "both",
+          where + ".audio.grid_features: use global, local or both (--grid-features)");
+  require(a.grid != "none" || a.grid_features == "global",
+          where + ".audio.grid_features: " + a.grid_features +
+              " reads the grid, and --grid none has none (leave --grid-features out)");
   require(a.view_directions == "spread" || a.view_directions == "reference",
           where + ".audio.view_directions: use spread or reference (--preset reference sets it)");
   require(a.resnet_batch_norm == "grid" || a.resnet_batch_norm == "running",

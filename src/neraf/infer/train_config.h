@@ -51,7 +51,11 @@ struct ScheduleConfig {
 };
 
 struct AudioConfig {
-  std::string grid = "sampled";     // sampled | none | zeros (the paper's ablations, --grid)
+  std::string grid = "sampled";  // sampled | none | zeros (the paper's ablations, --grid)
+  // How the encoded grid reaches NAcF (--grid-features; acoustic_model.h): "global" (the paper's
+  // one pooled vector per room), "local" (features read along each query's mic–source segment)
+  // or "both".
+  std::string grid_features = "global";
   int64_t start_step = 2000;        // audio losses from the step AFTER this one (reference: 2000)
   int64_t batch_size = 2048;        // (RIR, frame) slices per audio step
   int64_t grid_resolution = 32;     // S (cpu 32, paper 128)
@@ -104,6 +108,7 @@ struct AudioConfig {
   template <class V>
   void visit(V& v) {
     v("grid", grid);
+    v("grid_features", grid_features);
     v("start_step", start_step);
     v("batch_size", batch_size);
     v("grid_resolution", grid_resolution);
@@ -187,6 +192,7 @@ struct TrainFlags {
   std::optional<int64_t> rays;               // --rays
   std::optional<nerf::Precision> precision;  // --precision
   std::string grid = "sampled";              // --grid
+  std::optional<std::string> grid_features;  // --grid-features
   double audio_fraction = 1.0;               // --audio-fraction
   std::optional<int64_t> audio_start_step;   // --audio-start-step
   std::optional<double> decay_loss;          // --decay-loss

@@ -20,16 +20,20 @@ namespace neraf::train {
 using infer::TrainConfig;
 
 AudioBranch::AudioBranch(const TrainConfig& config, const data::RirSet& rirs,
-                         nerf::NerfactoModel field, bool frozen_field, torch::Device device)
+                         nerf::NerfactoModel field, const acoustic::WorldToField& world_to_field,
+                         bool frozen_field, torch::Device device)
     : AudioBranch(config, std::vector<const data::RirSet*>{&rirs},
-                  std::vector<nerf::NerfactoModel>{std::move(field)}, frozen_field, device) {}
+                  std::vector<nerf::NerfactoModel>{std::move(field)}, {world_to_field},
+                  frozen_field, device) {}
 
 AudioBranch::AudioBranch(const TrainConfig& config, const std::vector<const data::RirSet*>& scenes,
-                         const std::vector<nerf::NerfactoModel>& fields, bool frozen_field,
-                         torch::Device device)
+                         const std::vector<nerf::NerfactoModel>& fields,
+                         const std::vector<acoustic::WorldToField>& world_to_field,
+                         bool frozen_field, torch::Device device)
     : config_(config), frozen_(frozen_field), device_(device) {
-  TORCH_CHECK(!scenes.empty() && scenes.size() == fields.size(),
-              "AudioBranch: one radiance field per scene");
+  TORCH_CHECK(
+      !scenes.empty() && scenes.size() == fields.size() && scenes.size() == world_to_field.size(),
+      "AudioBranch: one radiance field and world map per scene");
   require(scenes.size() == 1 || frozen_,
           "multi-scene: only --modality audio (each scene's frozen vision run) is implemented");
   const data::RirSet& first = *scenes.front();
@@ -43,8 +47,9 @@ AudioBranch::AudioBranch(const TrainConfig& config, const std::vector<const data
         r->root + ": its RIRs differ in channels, frequencies or frames from " + first.root +
             "; one acoustic field needs scenes of one format");
   }
-  const acoustic::AcousticModelOptions opts = infer::audio_model_options(
-      config_, first.channels, first.n_freq, first.max_len, first.audio_aabb);
+  const acoustic::AcousticModelOptions opts =
+      infer::audio_model_options(config_, first.channels, first.n_freq, first.max_len,
+                                 first.audio_aabb, world_to_field.front());
   model_ = acoustic::AcousticModel(opts);
   model_->to(device_);
   for (size_t s = 0; s < scenes.size(); ++s) {
@@ -56,11 +61,13 @@ AudioBranch::AudioBranch(const TrainConfig& config, const std::vector<const data
     sc.train_rirs = infer::audio_train_subset(*sc.rirs, config_.audio.fraction, config_.seed);
     sc.offset = n_train_;
     n_train_ += static_cast<int64_t>(sc.train_rirs.size());
-    // This scene's box (the scene's own pose normalisation and relative-distance scale).
-    sc.nacf = infer::audio_model_options(config_, sc.rirs->channels, sc.rirs->n_freq,
-                                         sc.rirs->max_len, sc.rirs->audio_aabb)
-                  .nacf;
-    sc.nacf.grid_features = model_->options().nacf.grid_features;
+    // This scene's box (the scene's own pose normalisation and relative-distance scale) and map
+    // into its radiance field's frame.
+    sc.nacf = model_->options().nacf;
+    const data::Aabb& box = sc.rirs->audio_aabb;
+    sc.nacf.box_min = {box.min.x, box.min.y, box.min.z};
+    sc.nacf.box_max = {box.max.x, box.max.y, box.max.z};
+    sc.nacf.world_to_field = world_to_field[s];
     scenes_.push_back(std::move(sc));
     if (frozen_ && opts.grid_mode == acoustic::GridMode::kSampled) {
       // The paper's separate training: the field is final, so the whole grid is filled once.
@@ -146,7 +153,8 @@ std::pair<torch::Tensor, torch::Tensor> AudioBranch::forward_scenes(const torch:
   };
   // Stable per scene within [0, B) and within [B, M), so the whole RIRs stay frame-ordered.
   std::vector<torch::Tensor> preds, gts;
-  std::vector<torch::Tensor> features(scenes_.size());
+  std::vector<acoustic::SceneFeatures> features(scenes_.size());
+  std::vector<bool> encoded(scenes_.size(), false);
   using Range = std::pair<int64_t, int64_t>;
   for (const auto& [lo, hi] : {Range{0, B}, Range{B, M}})
     for (size_t s = 0; s < scenes_.size(); ++s) {
@@ -163,14 +171,15 @@ std::pair<torch::Tensor, torch::Tensor> AudioBranch::forward_scenes(const torch:
       torch::Tensor gt = torch::empty({rir.size(0), sc.rirs->channels, sc.rirs->n_freq},
                                       torch::kFloat32);  // [b, C, F]
       sc.rirs->gather_into(rir, f, gt);
-      if (!features[s].defined() && model_->options().grid_mode != acoustic::GridMode::kNone)
-        features[s] = model_->scene_feature(sc.grid->grid());  // [G], once per scene and step
+      if (!encoded[s]) {  // once per scene and step
+        features[s] = model_->scene_features(sc.grid->grid());
+        encoded[s] = true;
+      }
       const torch::Tensor mic = sc.rirs->mic_positions.index_select(0, rir);
       const torch::Tensor src = sc.rirs->source_positions.index_select(0, rir);
       const torch::Tensor rot = sc.rirs->rots.index_select(0, rir);
-      preds.push_back(model_->field()->forward(
-          acoustic::nacf_input(sc.nacf, features[s], f.to(device_), model_->options().max_len,
-                               mic.to(device_), src.to(device_), rot.to(device_))));
+      preds.push_back(model_->field()->forward(model_->nacf_input(
+          features[s], sc.nacf, f.to(device_), mic.to(device_), src.to(device_), rot.to(device_))));
       gts.push_back(gt.to(device_));
     }
   return {torch::cat(preds), torch::cat(gts)};  // [M, C, F] each

@@ -58,13 +58,17 @@ class AudioBranch : public Branch {
  public:
   // `field`: the radiance field that fills the grid (the vision branch's model in joint mode, or a
   // frozen model from a vision run in audio mode — then `frozen_field` = true and the grid is
-  // filled completely here). `rirs` must have features and outlive the branch.
+  // filled completely here). `rirs` must have features and outlive the branch. `world_to_field`
+  // maps the RIR positions into the field's frame (infer::world_to_field of the scene's images).
   AudioBranch(const infer::TrainConfig& config, const data::RirSet& rirs, nerf::NerfactoModel field,
-              bool frozen_field, torch::Device device);
-  // Multi-scene: scene s has `scenes[s]` and its frozen field `fields[s]` (N ≥ 1, same sizes;
-  // N ≥ 2 needs frozen fields). The RirSets must share channels, frequencies and frames per RIR.
+              const acoustic::WorldToField& world_to_field, bool frozen_field,
+              torch::Device device);
+  // Multi-scene: scene s has `scenes[s]`, its frozen field `fields[s]` and its map
+  // `world_to_field[s]` (N ≥ 1, same sizes; N ≥ 2 needs frozen fields). The RirSets must share
+  // channels, frequencies and frames per RIR.
   AudioBranch(const infer::TrainConfig& config, const std::vector<const data::RirSet*>& scenes,
-              const std::vector<nerf::NerfactoModel>& fields, bool frozen_field,
+              const std::vector<nerf::NerfactoModel>& fields,
+              const std::vector<acoustic::WorldToField>& world_to_field, bool frozen_field,
               torch::Device device);
 
   std::string name() const override { return "audio"; }
@@ -95,7 +99,7 @@ class AudioBranch : public Branch {
     acoustic::GridSampler grid{nullptr};
     std::vector<int64_t> train_rirs;  // indices into rirs->rirs
     int64_t offset = 0;               // position of its first train RIR among all scenes'
-    acoustic::NacfOptions nacf;       // the model's NAcF options with this scene's audio box
+    acoustic::NacfOptions nacf;  // the model's NAcF options with this scene's box and world map
   };
   // The step's (train RIR, frame) pairs, each [B + D·T] int64, the RIR as a position among all
   // scenes' train RIRs (scene s owns [offset, offset + its count)): batch_size slices (the

@@ -315,6 +315,16 @@ void Trainer::load_state(torch::serialize::InputArchive& a, const std::string& p
   }
 }
 
+namespace {
+
+// The frozen field's frame, from its run's manifest (read only when the grid is read per query).
+acoustic::WorldToField world_to_field_of(const TrainConfig& config, const LoadedRun& vision) {
+  if (config.audio.grid_features == "global") return acoustic::kIdentityWorldToField;
+  return infer::world_to_field(vision.manifest, vision.run_dir + "/data.json");
+}
+
+}  // namespace
+
 std::unique_ptr<Trainer> make_trainer(const TrainConfig& config, const data::ImageSet* images,
                                       torch::Device device, const data::RirSet* rirs) {
   validate(config, "config");
@@ -329,14 +339,16 @@ std::unique_ptr<Trainer> make_trainer(const TrainConfig& config, const data::Ima
             "--vision-run: required with --modality audio (a finished vision or joint run)");
     LoadedRun vision = infer::load_run(config.audio.vision_run, device);
     for (auto& p : vision.model->parameters()) p.set_requires_grad(false);
-    trainer->add_branch(
-        std::make_unique<AudioBranch>(config, *rirs, vision.model, /*frozen_field=*/true, device));
+    trainer->add_branch(std::make_unique<AudioBranch>(config, *rirs, vision.model,
+                                                      world_to_field_of(config, vision),
+                                                      /*frozen_field=*/true, device));
     return trainer;
   }
   require(images != nullptr, "--data: a vision run needs posed images (transforms.json)");
   trainer->add_branch(std::make_unique<VisionBranch>(config, images->train, device));
   if (config.modality == Modality::joint)
     trainer->add_branch(std::make_unique<AudioBranch>(config, *rirs, trainer->vision()->model(),
+                                                      infer::world_to_field(*images),
                                                       /*frozen_field=*/false, device));
   return trainer;
 }
@@ -349,13 +361,15 @@ std::unique_ptr<Trainer> make_multiscene_trainer(const TrainConfig& config,
           "multi-scene: one --vision-run per --data (--modality audio)");
   auto trainer = std::make_unique<Trainer>(config, device);
   std::vector<nerf::NerfactoModel> fields;
+  std::vector<acoustic::WorldToField> maps;
   for (const std::string& dir : config.audio.vision_runs) {
     LoadedRun vision = infer::load_run(dir, device);
     for (auto& p : vision.model->parameters()) p.set_requires_grad(false);
     fields.push_back(vision.model);
+    maps.push_back(world_to_field_of(config, vision));
   }
-  trainer->add_branch(
-      std::make_unique<AudioBranch>(config, scenes, fields, /*frozen_field=*/true, device));
+  trainer->add_branch(std::make_unique<AudioBranch>(config, scenes, fields, maps,
+                                                    /*frozen_field=*/true, device));
   return trainer;
 }
 
