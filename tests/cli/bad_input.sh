@@ -475,6 +475,10 @@ bad "--decay-loss" "$NERAF" train --data "$BASE/ss" --modality vision --decay-lo
   --steps 2 --quiet
 bad "--grid-resolution" "$NERAF" train --data "$BASE/ss" --grid none --grid-resolution 64 \
   --out @OUT@ --steps 2 --quiet
+bad "--grid-features" "$NERAF" train --data "$BASE/ss" --grid none --grid-features local \
+  --out @OUT@ --steps 2 --quiet
+bad "--grid-features" "$NERAF" train --data "$BASE/ss" --modality vision --grid-features both \
+  --out @OUT@ --steps 2 --quiet
 # P12 the run's own dataset as "new positions".
 bad "own dataset" "$NERAF" eval --run "$BASE/run" --novel-data "$BASE/ss" --json @OUT@.json \
   --skip-vision --no-baselines --quiet
