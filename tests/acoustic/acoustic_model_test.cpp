@@ -131,8 +131,10 @@ TEST(AcousticModel, LocalGridFeaturesAreReadPerQueryFromTheStemMap) {
   const auto h = m->nacf_input(f, m->options().nacf, b.t, b.mic, b.src, b.rot);
   const auto want = torch::cat(
       {nacf_input(torch::Tensor(), b.t, 12, b.mic, b.src, b.rot),  // unit box: metres as they are
-       local_geometry_features(f.volume, world_to_grid_input(b.mic, o.nacf.world_to_field),
-                               world_to_grid_input(b.src, o.nacf.world_to_field), 4)},
+       local_geometry_features(
+           f.volume,
+           strided_map_coordinates(world_to_grid_input(b.mic, o.nacf.world_to_field), 32, 16),
+           strided_map_coordinates(world_to_grid_input(b.src, o.nacf.world_to_field), 32, 16), 4)},
       1);
   EXPECT_TRUE(torch::allclose(h, want));
   // The gradient reaches the grid and the stem through the per-query features alone; the later

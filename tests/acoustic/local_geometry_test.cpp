@@ -90,6 +90,32 @@ TEST(LocalGeometry, WorldToGridInputAppliesTheMapThenTheContraction) {
                               ((q + 2) / 4).to(torch::kFloat32)));
 }
 
+// A stride-2 convolution that copies its centre tap (kernel 5, padding 2, as ResNet3D's stem):
+// map voxel o holds grid cell 2o, so reading the map at strided_map_coordinates(u) gives the grid
+// at u wherever u is the centre of an even cell, for even and odd S.
+TEST(LocalGeometry, StridedMapCoordinatesFindTheCellAVoxelIsCentredOn) {
+  torch::manual_seed(8);
+  for (int64_t s : {8, 9}) {
+    const torch::Tensor grid = torch::randn({1, 1, s, s, s}, torch::kFloat64);
+    torch::Tensor centre_tap = torch::zeros({1, 1, 5, 5, 5}, torch::kFloat64);
+    centre_tap[0][0][2][2][2] = 1.0;
+    const torch::Tensor map =
+        torch::conv3d(grid, centre_tap, {}, /*stride=*/2, /*padding=*/2)[0];  // [1, S', S', S']
+    ASSERT_EQ(map.size(1), (s + 1) / 2);
+    std::vector<double> even_cells;
+    for (int64_t i = 0; i < s; i += 2) even_cells.push_back((static_cast<double>(i) + 0.5) / s);
+    for (double x : even_cells)
+      for (double z : even_cells) {
+        const torch::Tensor u = torch::tensor({{x, even_cells[1], z}}, torch::kFloat64);
+        const double want = sample_volume(grid[0], u)[0][0].item<double>();
+        const double got =
+            sample_volume(map, strided_map_coordinates(u, s, map.size(1)))[0][0].item<double>();
+        EXPECT_NEAR(got, want, 1e-12) << "S " << s << " at " << x << ", " << z;
+      }
+  }
+  EXPECT_THROW(strided_map_coordinates(torch::zeros({1, 3}), 32, 15), c10::Error);
+}
+
 TEST(LocalGeometry, FeaturesAreMicSourceAndTheSegmentsMeanAndMax) {
   torch::manual_seed(5);
   const torch::Tensor volume = torch::rand({3, 8, 8, 8});

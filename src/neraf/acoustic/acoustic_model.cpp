@@ -123,10 +123,13 @@ torch::Tensor AcousticModelImpl::nacf_input(const SceneFeatures& features, const
     TORCH_CHECK(features.volume.defined(),
                 "AcousticModel: per-query grid features need the "
                 "stem map (scene_features of this model)");
-    local =
-        local_geometry_features(features.volume, world_to_grid_input(mic_m, scene.world_to_field),
-                                world_to_grid_input(src_m, scene.world_to_field),
-                                options_.segment_points);  // [B, 4L]
+    // The grid's cube → the stem map's frame (its conv1 has stride 2, padding kernel/2).
+    auto stem_frame = [&](const torch::Tensor& p_m) {
+      return strided_map_coordinates(world_to_grid_input(p_m, scene.world_to_field),
+                                     options_.grid.resolution, features.volume.size(1));
+    };
+    local = local_geometry_features(features.volume, stem_frame(mic_m), stem_frame(src_m),
+                                    options_.segment_points);  // [B, 4L]
   }
   return acoustic::nacf_input(scene, features.global, t, options_.max_len, mic_m, src_m, rot,
                               local);

@@ -30,6 +30,14 @@ torch::Tensor sample_volume(const torch::Tensor& volume, const torch::Tensor& u)
   return s.view({volume.size(0), -1}).t();                               // [N, L]
 }
 
+torch::Tensor strided_map_coordinates(const torch::Tensor& u, int64_t grid_resolution,
+                                      int64_t map_resolution) {
+  TORCH_CHECK(map_resolution == (grid_resolution + 1) / 2,
+              "strided_map_coordinates: a stride-2 map of ", grid_resolution, " cells has ",
+              (grid_resolution + 1) / 2, ", not ", map_resolution);
+  return (u * static_cast<double>(grid_resolution) + 0.5) / static_cast<double>(2 * map_resolution);
+}
+
 torch::Tensor local_geometry_features(const torch::Tensor& volume, const torch::Tensor& mic_u,
                                       const torch::Tensor& src_u, int64_t segment_points) {
   TORCH_CHECK(segment_points >= 1, "local_geometry_features: segment_points must be >= 1");

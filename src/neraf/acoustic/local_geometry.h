@@ -10,8 +10,11 @@
 // Coordinates: the volume covers the radiance field's hash-grid input cube u ∈ [0,1]³ (the voxel
 // grid's space, grid_sampler.h) with dims (D, H, W) = (x, y, z), as the grid's flat cell index.
 // Positions in the dataset's metres reach it through the data's world transform (WorldToField:
-// orientation, centring and scale of the image poses) and the scene contraction. Sampling is
-// trilinear between voxel centres ((i + 0.5)/n per axis), clamped to the border voxels.
+// orientation, centring and scale of the image poses; the RIR positions must be in the cameras'
+// frame, as `neraf synth` writes them) and the scene contraction. Sampling is trilinear between
+// voxel centres ((i + 0.5)/n per axis of the volume's own frame), clamped to the border voxels;
+// strided_map_coordinates moves a point of the grid into the frame of a map the grid was
+// convolved into with stride 2.
 #include <torch/types.h>
 
 #include <array>
@@ -30,7 +33,14 @@ torch::Tensor world_to_grid_input(const torch::Tensor& p_m, const WorldToField& 
 // Trilinear samples of volume [L, D, H, W] at u: [N, 3] → [N, L] (differentiable in the volume).
 torch::Tensor sample_volume(const torch::Tensor& volume, const torch::Tensor& u);
 
-// volume: [L, D, H, W]; mic_u, src_u: [B, 3] hash-grid inputs (world_to_grid_input);
+// u of an S-cell grid → the same point in the frame of a map made from it by a stride-2
+// convolution padded by half its (odd) kernel, whose voxel o is centred on grid cell 2o (S' =
+// ⌈S/2⌉ voxels): u' = (u·S + 0.5)/(2·S'), so that sample_volume(map, u') reads voxel o at cell
+// 2o's centre. [N, 3] → [N, 3].
+torch::Tensor strided_map_coordinates(const torch::Tensor& u, int64_t grid_resolution,
+                                      int64_t map_resolution);
+
+// volume: [L, D, H, W]; mic_u, src_u: [B, 3] in the volume's frame;
 // segment_points ≥ 1 → [B, 4·L] = [at mic, at source, mean and max over the segment's points
 // t_k = (k + 0.5)/K, k = 0..K−1].
 torch::Tensor local_geometry_features(const torch::Tensor& volume, const torch::Tensor& mic_u,

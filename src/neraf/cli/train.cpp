@@ -176,8 +176,9 @@ void register_train(CLI::App& app) {
       cmd->add_option("--grid-features", args->grid_features,
                       "How the acoustic field reads the encoded grid: global (one pooled vector "
                       "per room, NeRAF), local (the scene encoder's volume read at the "
-                      "microphone, at the source and along the segment between them, per query) "
-                      "or both")
+                      "microphone, at the source and along the segment between them, per query; "
+                      "the RIR positions must be in the cameras' frame, as neraf synth writes "
+                      "them) or both")
           ->check(CLI::IsMember({"global", "local", "both"}))
           ->capture_default_str();
   args->grid_resolution_opt =

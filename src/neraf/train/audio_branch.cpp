@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <tuple>
 
 #include "neraf/acoustic/calibration.h"
@@ -14,6 +15,7 @@
 #include "neraf/metrics/room_acoustics.h"
 #include "neraf/train/distributed.h"
 #include "neraf/util/error.h"
+#include "neraf/util/log.h"
 
 namespace neraf::train {
 
@@ -68,6 +70,13 @@ AudioBranch::AudioBranch(const TrainConfig& config, const std::vector<const data
     sc.nacf.box_min = {box.min.x, box.min.y, box.min.z};
     sc.nacf.box_max = {box.max.x, box.max.y, box.max.z};
     sc.nacf.world_to_field = world_to_field[s];
+    if (opts.grid_features != acoustic::GridFeatures::kGlobal &&
+        !std::filesystem::exists(std::filesystem::path(sc.rirs->root) / "synth_info.json"))
+      warn(sc.rirs->root + ": --grid-features " + config_.audio.grid_features +
+           " reads the grid at the RIR positions mapped by the cameras' world transform, which "
+           "assumes the RIRs and the cameras share one frame; neraf synth writes them so, but "
+           "this dataset was not made by neraf synth (the published SoundSpaces and RAF frames "
+           "are aligned by hand)");
     scenes_.push_back(std::move(sc));
     if (frozen_ && opts.grid_mode == acoustic::GridMode::kSampled) {
       // The paper's separate training: the field is final, so the whole grid is filled once.
