@@ -51,9 +51,11 @@ else
   OUT=build/experiments
   REPORT=(--doc docs/RESULTS.md --raw docs/results/experiments --images docs/images/results)
   SEEDS=(1 2 3)
-  JOINT=()   # the default neraf train: cpu preset, joint, 3000 steps (audio from step 1000)
-  VISION=()  # cpu vision run: 2000 steps
-  AUDIO=()   # cpu audio run on a frozen field: 1500 steps
+  # The cpu preset's fixed schedule, given explicitly: without --steps a larger room would get more
+  # audio steps (fit_run_length_to_data), and a few-shot run fewer than the full one.
+  JOINT=(--steps 3000)  # cpu preset, joint, 3000 steps (audio from step 1000)
+  VISION=()             # cpu vision run: 2000 steps
+  AUDIO=(--steps 1500)  # cpu audio run on a frozen field: 1500 steps
   # Experiment 4 compares vision-only with joint training at the same number of steps (joint's
   # 3000), so the only difference is the acoustic branch.
   VIEWS_JOINT=()

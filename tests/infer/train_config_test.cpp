@@ -43,6 +43,7 @@ TEST(ResolveTrainConfig, DefaultFlagsAreTheCpuJointRun) {
   EXPECT_EQ(to_json(c).dump(), [] {
     TrainConfig p = train_preset("cpu");
     p.modality = Modality::joint;
+    p.steps_from_data = true;  // no --steps: the run's data decides (FitRunLengthToData)
     return to_json(p).dump();
   }());
 }
@@ -73,6 +74,54 @@ TEST(ResolveTrainConfig, CpuRunLengthPerModality) {
   EXPECT_EQ(audio.audio.start_step, -1);
   EXPECT_EQ(audio.audio.schedule.warmup_start, 0);
   EXPECT_EQ(audio.audio.schedule.warmup_steps, 100);
+}
+
+TEST(ResolveTrainConfig, FitRunLengthToData) {
+  // A small room keeps the fixed schedule: 2000 audio steps joint, 1500 audio-only.
+  TrainConfig joint = resolve("cpu", Modality::joint);
+  ASSERT_TRUE(joint.steps_from_data);
+  RunLengthFit fit = fit_run_length_to_data(joint, 371 * 86);
+  EXPECT_EQ(fit.audio_steps_before, 1999);  // steps 1001..2999
+  EXPECT_EQ(fit.audio_steps_after, 1999);
+  EXPECT_EQ(joint.steps, 3000);
+
+  // 8 passes over 200k slices of 512: 3125 audio steps; the tied decays follow the new length,
+  // the audio start and warm-up do not move.
+  fit = fit_run_length_to_data(joint, 200000);
+  EXPECT_EQ(fit.audio_steps_after, 3125);
+  EXPECT_EQ(joint.steps, 1001 + 3125);
+  EXPECT_EQ(joint.fields.max_steps, joint.steps);
+  EXPECT_EQ(joint.audio.schedule.max_steps, joint.steps);
+  EXPECT_EQ(joint.audio.start_step, 1000);
+  EXPECT_EQ(joint.audio.schedule.warmup_start, 1000);
+  EXPECT_EQ(joint.audio.schedule.warmup_steps, 100);
+
+  // The 20k-RIR apartment (18,413 train RIRs × 86 frames) gets the cap, audio-only as joint.
+  TrainConfig audio = resolve("cpu", Modality::audio);
+  fit = fit_run_length_to_data(audio, 18413 * 86);
+  EXPECT_EQ(fit.audio_steps_before, 1500);
+  EXPECT_EQ(fit.audio_steps_after, kCpuMaxAudioSteps);
+  EXPECT_EQ(audio.steps, kCpuMaxAudioSteps);
+  EXPECT_EQ(audio.audio.schedule.max_steps, kCpuMaxAudioSteps);
+
+  // --steps, the paper preset and vision runs keep their length.
+  TrainFlags f;
+  f.steps = 5000;
+  TrainConfig given = resolve("cpu", Modality::joint, f);
+  EXPECT_FALSE(given.steps_from_data);
+  EXPECT_EQ(fit_run_length_to_data(given, 18413 * 86).audio_steps_after, 3999);
+  EXPECT_EQ(given.steps, 5000);
+  TrainConfig paper = resolve("paper", Modality::joint);
+  EXPECT_FALSE(paper.steps_from_data);
+  fit_run_length_to_data(paper, 18413 * 86);
+  EXPECT_EQ(paper.steps, 400001);
+  EXPECT_FALSE(resolve("cpu", Modality::vision).steps_from_data);
+
+  // Recorded in config.json; a config without the key (an older run) reads as not fitted.
+  EXPECT_TRUE(train_config_from_json(to_json(joint), "x").steps_from_data);
+  nlohmann::json old = to_json(joint);
+  old.erase("steps_from_data");
+  EXPECT_FALSE(train_config_from_json(old, "x").steps_from_data);
 }
 
 TEST(ResolveTrainConfig, PaperRunLengthPerModality) {

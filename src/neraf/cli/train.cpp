@@ -146,9 +146,13 @@ void register_train(CLI::App& app) {
           ->capture_default_str();
   CLI::Option* steps =
       cmd->add_option("--steps", args->steps,
-                      "Total training steps (default: cpu 3000 joint, 2000 vision, 1500 audio; "
-                      "paper, reference 400001 joint, 30000 vision, 398000 audio). With --resume: "
-                      "train on to this step")
+                      "Total training steps (default: cpu 3000 joint, 2000 vision, 1500 audio, "
+                      "more audio steps on a large dataset: " +
+                          std::to_string(infer::kCpuAudioPasses) +
+                          " passes over its (RIR, frame) slices, at most " +
+                          std::to_string(infer::kCpuMaxAudioSteps) +
+                          " audio steps; paper, reference 400001 joint, 30000 vision, 398000 "
+                          "audio). With --resume: train on to this step")
           ->transform(whole_number(1, kMaxSteps));
   CLI::Option* seed = cmd->add_option("--seed", args->seed, "Random seed")
                           ->transform(seed_number())

@@ -231,7 +231,8 @@ nlohmann::json comparable(nlohmann::json j) {
   for (nlohmann::json* s : {&j["fields"], &j["proposal_networks"], &j["audio"]["schedule"]})
     if (s->is_object() && s->value("max_steps", nlohmann::json()) == steps)
       (*s)["max_steps"] = "steps";
-  for (const char* k : {"steps", "threads", "save_every", "eval_rays_per_chunk"}) j.erase(k);
+  for (const char* k : {"steps", "steps_from_data", "threads", "save_every", "eval_rays_per_chunk"})
+    j.erase(k);
   if (j.contains("model")) j["model"].erase("precision");
   // Vision runs ignore the acoustic settings (and checkpoints older than them have none).
   if (j.value("modality", "") == "vision") j.erase("audio");

@@ -39,6 +39,7 @@ TrainConfig resolve_train_config(const TrainFlags& f) {
   // joint runs keep 3000, as the acoustic field starts at step 1000.
   if (cfg.modality == Modality::vision && !paper) set_run_length(cfg, 2000);
   if (f.steps) set_run_length(cfg, *f.steps);
+  cfg.steps_from_data = !f.steps && !paper && cfg.modality != Modality::vision;
   cfg.seed = f.seed;
   if (f.audio_start_step) {
     if (cfg.audio.schedule.warmup_start == std::max<int64_t>(0, cfg.audio.start_step))  // from it
@@ -72,6 +73,19 @@ TrainConfig resolve_train_config(const TrainFlags& f) {
   if (f.rays) cfg.rays_per_batch = *f.rays;
   if (f.precision) cfg.model.precision = *f.precision;
   return cfg;
+}
+
+RunLengthFit fit_run_length_to_data(TrainConfig& c, int64_t train_slices) {
+  const int64_t audio_steps = c.steps - std::max<int64_t>(0, c.audio.start_step + 1);
+  RunLengthFit fit{audio_steps, audio_steps};
+  if (!c.steps_from_data || c.modality == Modality::vision) return fit;
+  const double wanted =
+      std::ceil(static_cast<double>(kCpuAudioPasses) * static_cast<double>(train_slices) /
+                static_cast<double>(std::max<int64_t>(1, c.audio.batch_size)));
+  fit.audio_steps_after = std::clamp(static_cast<int64_t>(std::min(wanted, 1e15)), audio_steps,
+                                     std::max(audio_steps, kCpuMaxAudioSteps));
+  set_run_length(c, c.steps + fit.audio_steps_after - audio_steps);
+  return fit;
 }
 
 int64_t num_scenes(const TrainConfig& c) {

@@ -143,6 +143,9 @@ struct TrainConfig {
   uint64_t seed = 42;
   int threads = 0;           // 0: LibTorch's default (all cores)
   int64_t save_every = 500;  // checkpoint period in steps (and always at the end)
+  // The run's length was not given (cpu preset, no --steps): a new run lengthens its acoustic
+  // schedule to the data it finds (fit_run_length_to_data). Recorded, never re-applied on resume.
+  bool steps_from_data = false;
   int64_t eval_rays_per_chunk = 16384;
   ScheduleConfig fields;             // "fields" group: the radiance field
   ScheduleConfig proposal_networks;  // "proposal_networks" group
@@ -159,6 +162,7 @@ struct TrainConfig {
     v("seed", seed);
     v("threads", threads);
     v("save_every", save_every);
+    v("steps_from_data", steps_from_data);
     v("eval_rays_per_chunk", eval_rays_per_chunk);
     v("fields", fields);
     v("proposal_networks", proposal_networks);
@@ -170,6 +174,20 @@ struct TrainConfig {
 
 // Sets c.steps; schedules whose decay was tied to the run length (max_steps == c.steps) follow.
 void set_run_length(TrainConfig& c, int64_t steps);
+
+// How the cpu preset's schedule scales with the data (issue 14). A run of steps_from_data gets
+// more audio steps when its training set has more (RIR, frame) slices than the fixed schedule
+// covers: audio steps = clamp(kCpuAudioPasses × train_slices / audio.batch_size, the preset's
+// audio steps, kCpuMaxAudioSteps), the run lengthened by the difference (set_run_length: the
+// tied decays follow, the warm-up keeps its length). A small room (the demo: 371 RIRs) keeps the
+// fixed schedule; the 20k-RIR apartment gets the cap, sized to finish in an hour on 2 cores.
+// Returns the audio steps before and after; a run without steps_from_data is left as it is.
+inline constexpr int64_t kCpuAudioPasses = 8;
+inline constexpr int64_t kCpuMaxAudioSteps = 14000;
+struct RunLengthFit {
+  int64_t audio_steps_before = 0, audio_steps_after = 0;
+};
+RunLengthFit fit_run_length_to_data(TrainConfig& c, int64_t train_slices);
 
 // The named preset (throws neraf::Error naming --preset for unknown names):
 //   paper      the published sizes and schedule, with our grid sampler directions and BatchNorm
@@ -211,7 +229,8 @@ struct TrainFlags {
 //   - modality audio (the field is final, the grid is filled once): audio from the first step
 //     (start_step −1) after a warm-up of 100 steps (cpu) or 2000 (paper, reference), capped at half
 //     the audio schedule's length so that a short run still gets a (shorter) warm-up.
-//   - --steps N sets the run length (set_run_length) before that cap.
+//   - --steps N sets the run length (set_run_length) before that cap; without it a cpu run that
+//     trains audio is steps_from_data (fit_run_length_to_data, once its data is loaded).
 //   - --audio-start-step S: start_step = S, and a warm-up that ended where audio started still
 //     ends there (max(0, S)).
 //   - --seed, --grid, --grid-resolution, --audio-fraction, --audio-loss, --decay-loss,

@@ -186,6 +186,24 @@ std::string comparable_manifest(nlohmann::json manifest) {
   return manifest.dump();
 }
 
+// A new cpu run without --steps: as many audio steps as its data needs (infer::
+// fit_run_length_to_data); every rank computes the same from the same data.
+void fit_run_length(TrainConfig& cfg, const std::vector<const data::RirSet*>& scenes, bool resume,
+                    bool lead) {
+  if (resume || scenes.empty()) return;
+  int64_t slices = 0;
+  for (const data::RirSet* r : scenes)
+    slices +=
+        static_cast<int64_t>(infer::audio_train_subset(*r, cfg.audio.fraction, cfg.seed).size()) *
+        r->max_len;
+  const infer::RunLengthFit fit = infer::fit_run_length_to_data(cfg, slices);
+  if (lead && fit.audio_steps_after != fit.audio_steps_before)
+    info("cpu preset: " + std::to_string(slices) + " training (RIR, frame) slices, so " +
+         std::to_string(fit.audio_steps_after) + " audio steps instead of " +
+         std::to_string(fit.audio_steps_before) + " (" + std::to_string(cfg.steps) +
+         " steps in all; --steps N sets the length)");
+}
+
 // `dist`: null for one process. Rank 0 (or the only process) is the "lead": it alone touches
 // the run folder.
 TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOptions& options,
@@ -296,6 +314,7 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
       manifest["scenes"].push_back(sc.manifest);
       all_rirs.push_back(sc.rirs.get());
     }
+    fit_run_length(cfg, all_rirs, options.resume, lead);
     trainer = make_multiscene_trainer(cfg, all_rirs, options.device);
   } else {
     require(options.scene_data_dirs.empty(),
@@ -337,6 +356,7 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
       if (lead) dist->share_from_rank0("data manifest", manifest.dump());
       dist->check_same_json("data", "dataset", comparable_manifest(manifest));
     }
+    fit_run_length(cfg, all_rirs, options.resume, lead);
     trainer = make_trainer(cfg, &images, options.device, rirs.get());
   }
   if (dist) {
