@@ -33,7 +33,7 @@ for preset in ("cpu", "paper"):
         j = json.load(open(os.path.join(work, f"{preset}_{mode}.json")))
         med = next(b for b in j["benchmarks"] if b.get("aggregate_name") == "median")
         cases[f"{preset}_{mode}"] = {"median_s": med["real_time"] / 1e3,
-                                     "iterations": med["iterations"],
+                                     "repetitions": med["iterations"],
                                      "rays": med["rays"], "audio_slices": med["audio_slices"],
                                      "grid_cells_per_step": med["grid_cells_per_step"]}
 ctx = j["context"]
