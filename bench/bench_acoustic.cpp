@@ -6,6 +6,7 @@
 //   build-x/neraf_bench_acoustic                      # writes bench/results/acoustic.json
 //   build-x/neraf_bench_acoustic --benchmark_filter=cpu
 // Without --benchmark_out the JSON goes to <repo>/bench/results/acoustic.json.
+#include <ATen/autocast_mode.h>
 #include <benchmark/benchmark.h>
 #include <malloc.h>
 #include <torch/torch.h>
@@ -82,6 +83,62 @@ void BM_ResNet3dFwdBwd(benchmark::State& state) {
     benchmark::DoNotOptimize(y.data_ptr());
   }
   set_label(state, preset, false);
+}
+
+// The same fwd+bwd in six variants (issue 14 §4: where can ResNet3D's step go faster?): fp32 or
+// bf16 weights and grid (bit 0) or fp32 ones under CPU autocast to bf16 (bit 2: convolutions in
+// bf16, batch norm in fp32), contiguous (NCDHW) or channels-last (NDHWC, bit 1) tensors. Counters: the
+// features' and the grid gradient's relative error (L2) against fp32 contiguous.
+void BM_ResNet3dLayouts(benchmark::State& state) {
+  const int64_t preset = state.range(0);
+  const bool bf16 = state.range(1) & 1, channels_last = state.range(1) & 2,
+             autocast = state.range(1) & 4, fp64 = state.range(1) & 8;
+  const auto o = options_for(preset, false);
+  const int64_t s = o.grid.resolution;
+  torch::manual_seed(0);
+  ResNet3d reference(o.resnet);
+  torch::manual_seed(0);
+  ResNet3d net(o.resnet);
+  const auto format = channels_last ? torch::MemoryFormat::ChannelsLast3d
+                                    : torch::MemoryFormat::Contiguous;
+  const auto dtype = bf16 ? torch::kBFloat16 : fp64 ? torch::kFloat64 : torch::kFloat32;
+  net->to(dtype);
+  for (auto& p : net->parameters()) {
+    if (p.dim() == 5) p.set_data(p.contiguous(format));
+  }
+  const auto grid32 = torch::rand({1, 7, s, s, s});
+  // A fixed random projection as the loss: the sum of the features would back-propagate almost
+  // nothing through the last BatchNorm (its output's mean is fixed), a gradient of rounding noise.
+  const auto probe = torch::randn({1, net->out_features()});
+  auto grid = grid32.to(dtype).contiguous(format).detach().requires_grad_();
+  auto run = [&] {
+    net->zero_grad();
+    grid.mutable_grad() = torch::Tensor();
+    at::autocast::set_cpu_enabled(autocast);
+    at::autocast::set_autocast_cpu_dtype(torch::kBFloat16);
+    auto y = net->forward(grid);
+    at::autocast::set_cpu_enabled(false);
+    at::autocast::clear_cache();
+    (y * probe.to(y.scalar_type())).sum().backward();
+    return y;
+  };
+  torch::Tensor y;
+  for (auto _ : state) {
+    y = run();
+    benchmark::DoNotOptimize(y.data_ptr());
+  }
+  auto grid_ref = grid32.detach().clone().requires_grad_();
+  const auto y_ref = reference->forward(grid_ref);
+  (y_ref * probe).sum().backward();
+  auto relative = [](const torch::Tensor& a, const torch::Tensor& ref) {
+    return (a.to(torch::kFloat32) - ref).norm().item<double>() / ref.norm().item<double>();
+  };
+  state.counters["feature_rel_err"] = relative(y.detach(), y_ref.detach());
+  state.counters["grid_grad_rel_err"] = relative(grid.grad(), grid_ref.grad());
+  state.SetLabel(std::string(preset_name(preset)) +
+                 (bf16 ? "/bf16" : autocast ? "/autocast-bf16" : fp64 ? "/fp64" : "/fp32") +
+                 (channels_last ? "/channels-last" : "/contiguous") +
+                 " threads=" + std::to_string(torch::get_num_threads()));
 }
 
 // NAcF on 2048 slices (encoders included) + loss, fwd+bwd. Reports the bf16 output error against
@@ -184,6 +241,13 @@ void BM_RenderStftCachedFeature(benchmark::State& state) {
 NERAF_CPU(BM_AcousticStep, 0);
 NERAF_CPU(BM_AcousticStep, 1);
 NERAF_CPU(BM_ResNet3dFwdBwd, 0);
+NERAF_CPU(BM_ResNet3dLayouts, 0);
+NERAF_CPU(BM_ResNet3dLayouts, 1);
+NERAF_CPU(BM_ResNet3dLayouts, 2);
+NERAF_CPU(BM_ResNet3dLayouts, 3);
+NERAF_CPU(BM_ResNet3dLayouts, 4);
+NERAF_CPU(BM_ResNet3dLayouts, 6);
+NERAF_CPU(BM_ResNet3dLayouts, 8);
 NERAF_CPU(BM_NacfFwdBwd, 0);
 NERAF_CPU(BM_NacfFwdBwd, 1);
 NERAF_CPU(BM_AdamStep, 0);
@@ -198,6 +262,13 @@ BENCHMARK(BM_RenderStftCachedFeature)->Args({1, 1})->Unit(benchmark::kMillisecon
 NERAF_PAPER(BM_AcousticStep, 0);
 NERAF_PAPER(BM_AcousticStep, 1);
 NERAF_PAPER(BM_ResNet3dFwdBwd, 0);
+NERAF_PAPER(BM_ResNet3dLayouts, 0);
+NERAF_PAPER(BM_ResNet3dLayouts, 1);
+NERAF_PAPER(BM_ResNet3dLayouts, 2);
+NERAF_PAPER(BM_ResNet3dLayouts, 3);
+NERAF_PAPER(BM_ResNet3dLayouts, 4);
+NERAF_PAPER(BM_ResNet3dLayouts, 6);
+NERAF_PAPER(BM_ResNet3dLayouts, 8);
 NERAF_PAPER(BM_NacfFwdBwd, 0);
 NERAF_PAPER(BM_NacfFwdBwd, 1);
 NERAF_PAPER(BM_AdamStep, 0);

@@ -103,6 +103,22 @@ TEST(ResNet3d, CpuVariantShapeAndSize) {
   EXPECT_EQ(y.sizes(), (std::vector<int64_t>{1, 256}));
 }
 
+// A bf16 network (the layout benchmark's variant) runs end to end, the max pool included, and its
+// feature stays within bf16 rounding of the fp32 one with the same weights (measured 0.8 %).
+TEST(ResNet3d, Bfloat16ForwardMatchesFp32) {
+  torch::manual_seed(4);
+  ResNet3d net(resnet3d_cpu_options());
+  const auto x = torch::rand({1, 7, 32, 32, 32});
+  const auto fp32 = net->forward(x);
+  net->to(torch::kBFloat16);
+  const auto bf16 = net->forward(x.to(torch::kBFloat16));
+  ASSERT_EQ(bf16.scalar_type(), torch::kBFloat16);
+  const double relative =
+      (bf16.to(torch::kFloat32) - fp32).norm().item<double>() / fp32.norm().item<double>();
+  EXPECT_GT(relative, 0.0);  // it did run in bf16
+  EXPECT_LT(relative, 0.03);
+}
+
 TEST(ResNet3d, EvalEqualsTrainModeOnTheSameGrid) {
   torch::manual_seed(3);
   ResNet3d net(resnet3d_cpu_options());

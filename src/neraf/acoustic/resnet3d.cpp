@@ -143,7 +143,10 @@ std::pair<torch::Tensor, torch::Tensor> ResNet3dImpl::stem_and_map(const torch::
   const auto s = stem(x);
   auto h = s;
   if (options_.stem_max_pool) {
-    h = torch::max_pool3d(h, /*kernel_size=*/3, /*stride=*/2, /*padding=*/1);
+    // LibTorch 1.13 has no bf16 max_pool3d on CPU: pool a bf16 map in fp32 (exact: a max).
+    const auto dtype = h.scalar_type();
+    if (dtype == torch::kBFloat16) h = h.to(torch::kFloat32);
+    h = torch::max_pool3d(h, /*kernel_size=*/3, /*stride=*/2, /*padding=*/1).to(dtype);
   }
   for (auto& stage : layers_) h = stage->forward(h);
   return {s, h};
