@@ -17,13 +17,13 @@ namespace {
 using testing::NerfstudioScene;
 using testing::TempDir;
 
-ImageLoadOptions quiet() {
+ImageLoadOptions quiet_images() {
   ImageLoadOptions o;
   o.progress = false;
   return o;
 }
 
-std::string error_of(const std::string& dir, ImageLoadOptions o = quiet()) {
+std::string error_of(const std::string& dir, ImageLoadOptions o = quiet_images()) {
   try {
     load_transforms_json(dir, o);
   } catch (const Error& e) {
@@ -36,7 +36,7 @@ TEST(ImageSet, FilenameSplitIntrinsicsAndPixels) {
   TempDir dir;
   NerfstudioScene scene;
   scene.write(dir.path());
-  const ImageSet set = load_transforms_json(dir.path(), quiet());
+  const ImageSet set = load_transforms_json(dir.path(), quiet_images());
   EXPECT_EQ(set.eval_mode, "filename");
   // Frames are sorted by path: eval_0000 < train_0000 < train_0001 < train_0002.
   ASSERT_EQ(set.train.size(), 3);
@@ -75,7 +75,7 @@ TEST(ImageSet, FractionSplitUsesNumpyLinspaceTruncation) {
     scene.names.push_back(buf);
   }
   scene.write(dir.path());
-  const ImageSet set = load_transforms_json(dir.path(), quiet());
+  const ImageSet set = load_transforms_json(dir.path(), quiet_images());
   EXPECT_EQ(set.eval_mode, "fraction");
   // ceil(0.9·10) = 9 train; linspace(0, 9, 9) = 0, 1.125, ..., 7.875, 9 -> ints 0..7, 9.
   ASSERT_EQ(set.train.size(), 9);
@@ -97,7 +97,7 @@ TEST(ImageSet, PoseNormalisationMatchesNerfstudio) {
       {"file_path": "a.png", "transform_matrix": [[1,0,0,1],[0,1,0,0],[0,0,1,0],[0,0,0,1]]},
       {"file_path": "b.png", "transform_matrix": [[1,0,0,3],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}]})";
   testing::write_text(dir / "transforms.json", json);
-  ImageLoadOptions o = quiet();
+  ImageLoadOptions o = quiet_images();
   o.eval_mode = "fraction";
   o.train_fraction = 1.0;
   const ImageSet set = load_transforms_json(dir.path(), o);
@@ -124,7 +124,7 @@ TEST(ImageSet, OrientationOverrideNoneAndAutoScale) {
   NerfstudioScene scene;
   scene.extra_top_level = "\"orientation_override\": \"none\",";
   scene.write(dir.path());
-  const ImageSet set = load_transforms_json(dir.path(), quiet());
+  const ImageSet set = load_transforms_json(dir.path(), quiet_images());
   // No rotation: R = I; translation −mean; scale 1 / max |t|.
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -155,7 +155,7 @@ TEST(ImageSet, UpOrientationMapsTheMeanUpToZ) {
   TempDir dir;
   NerfstudioScene scene;
   scene.write(dir.path());
-  const ImageSet set = load_transforms_json(dir.path(), quiet());
+  const ImageSet set = load_transforms_json(dir.path(), quiet_images());
   // Every camera's y axis is +y in the dataset; after orientation it is +z.
   const torch::Tensor all = torch::cat({set.train.camera_to_world, set.eval.camera_to_world});
   for (int64_t i = 0; i < all.size(0); ++i) {
@@ -213,7 +213,7 @@ TEST(ImageSet, ErrorsNameTheFrameAndFile) {
         {"file_path": "images/train_0001.png", "transform_matrix": [[-1,0,0,3],[0,1,0,0],[0,0,1,0],[0,0,0,1]]}]})";
     testing::write_text(dir / "transforms.json", scaled);
     ProblemList problems;
-    check_transforms_json(dir.path(), quiet(), problems);
+    check_transforms_json(dir.path(), quiet_images(), problems);
     ASSERT_EQ(problems.num_errors(), 2) << problems.items()[0].to_string();
     EXPECT_NE(problems.items()[0].what.find("frames[0]"), std::string::npos);
     EXPECT_NE(problems.items()[0].what.find("not a rotation"), std::string::npos);
@@ -263,7 +263,7 @@ TEST(ImageSet, RafSizedFractionSplitCounts) {
         dir / "transforms.json",
         R"({"fl_x": 10, "fl_y": 10, "cx": 6, "cy": 4, "w": 12, "h": 8, "frames": [)" + frames +
             "]}");
-    ImageLoadOptions o = quiet();
+    ImageLoadOptions o = quiet_images();
     o.load_pixels = false;
     const ImageSet set = load_transforms_json(dir.path(), o);
     EXPECT_EQ(set.train.size(), want);

@@ -25,7 +25,7 @@ using testing::RafRoom;
 using testing::SoundSpacesScene;
 using testing::TempDir;
 
-RirLoadOptions quiet() {
+RirLoadOptions quiet_rirs() {
   RirLoadOptions o;
   o.progress = false;
   return o;
@@ -76,7 +76,7 @@ TEST(SoundSpaces, PosesHeadingsSplitsAndAabb) {
   TempDir dir;
   SoundSpacesScene scene;
   scene.write(dir.path());
-  RirLoadOptions o = quiet();
+  RirLoadOptions o = quiet_rirs();
   o.load_features = false;
   const RirSet set = load_rir_set(dir.path(), o);
   EXPECT_EQ(set.layout, AudioLayout::soundspaces);
@@ -122,7 +122,7 @@ TEST(SoundSpaces, FeaturesEqualTheDirectRecipeWithPaddingAndAutoMaxLen) {
   TempDir dir;
   SoundSpacesScene scene;
   scene.write(dir.path());
-  const RirSet set = load_soundspaces(dir.path(), quiet());
+  const RirSet set = load_soundspaces(dir.path(), quiet_rirs());
   // max_len = longest STFT: the 20001-sample RIR -> 10001 @ 22.05k (round half up) + 256 -> 81.
   int64_t longest = 0;
   for (const auto& e : scene.entries) longest = std::max(longest, e.samples);
@@ -151,7 +151,7 @@ TEST(SoundSpaces, EvalWaveformIsClippedResampledAndCut) {
   TempDir dir;
   SoundSpacesScene scene;
   scene.write(dir.path());
-  const RirSet set = load_soundspaces(dir.path(), quiet());
+  const RirSet set = load_soundspaces(dir.path(), quiet_rirs());
   for (const int64_t i : {int64_t(0), int64_t(1)}) {
     const torch::Tensor w = set.waveform(i);
     ASSERT_EQ(w.sizes(), (std::vector<int64_t>{2, set.max_len * 128}));
@@ -169,7 +169,7 @@ TEST(SoundSpaces, ExplicitMaxLenCutsAndHalfPrecisionIsClose) {
   TempDir dir;
   SoundSpacesScene scene;
   scene.write(dir.path());
-  RirLoadOptions o = quiet();
+  RirLoadOptions o = quiet_rirs();
   o.max_len = 40;
   const RirSet set = load_soundspaces(dir.path(), o);
   EXPECT_EQ(set.max_len, 40);
@@ -205,7 +205,7 @@ TEST(SoundSpaces, PublishedMagnitudeFilesAreUsedWhenPresent) {
         dir / ("binaural_magnitudes_sr22050/" + SoundSpacesScene::key(scene.entries[i]) + ".npy"),
         {2, 257, t}, v);
   }
-  const RirSet set = load_soundspaces(dir.path(), quiet());
+  const RirSet set = load_soundspaces(dir.path(), quiet_rirs());
   // The longest training magnitude file (entries 5 and 6, 55 and 62 frames, are test RIRs: cut).
   EXPECT_EQ(set.max_len, 20 + 7 * 4);
   for (size_t i = 0; i < mags.size(); ++i) {
@@ -214,7 +214,7 @@ TEST(SoundSpaces, PublishedMagnitudeFilesAreUsedWhenPresent) {
     expect_close(set.features(i), pad_to(torch::log(mags[i] + 1e-3f), set.max_len, mn), 1e-6);
   }
   // Opting out computes from the wavs instead.
-  RirLoadOptions o = quiet();
+  RirLoadOptions o = quiet_rirs();
   o.use_magnitude_files = false;
   const RirSet from_wav = load_soundspaces(dir.path(), o);
   EXPECT_TRUE(from_wav.rirs[0].magnitude_path.empty());
@@ -226,7 +226,7 @@ TEST(SoundSpaces, AutomaticMaxLenIsTheLongestTrainingRir) {
   SoundSpacesScene scene;
   scene.entries[5].samples = 30001;  // a test RIR longer than every training RIR
   scene.write(dir.path());
-  const RirSet set = load_soundspaces(dir.path(), quiet());
+  const RirSet set = load_soundspaces(dir.path(), quiet_rirs());
   EXPECT_EQ(set.max_len, 81);  // the 20001-sample training RIR, as before
   EXPECT_EQ(set.max_len_source, "longest training RIR");
   EXPECT_TRUE(set.max_len_note.empty());
@@ -243,7 +243,7 @@ TEST(SoundSpaces, PublishedSceneUsesThePublishedMaxLenWithANote) {
   SoundSpacesScene scene;
   scene.write(root);
   for (const std::string& path : {root, root + "/"}) {
-    const RirSet set = load_soundspaces(path, quiet());
+    const RirSet set = load_soundspaces(path, quiet_rirs());
     EXPECT_EQ(set.max_len, 78);
     EXPECT_EQ(set.waveform_length, 78 * 128);
     EXPECT_EQ(set.max_len_source, "published (office_4)");
@@ -251,7 +251,7 @@ TEST(SoundSpaces, PublishedSceneUsesThePublishedMaxLenWithANote) {
     EXPECT_NE(set.max_len_note.find("81 frames"), std::string::npos) << set.max_len_note;
     EXPECT_NE(set.max_len_note.find("--max-len 81"), std::string::npos) << set.max_len_note;
   }
-  RirLoadOptions o = quiet();
+  RirLoadOptions o = quiet_rirs();
   o.max_len = 81;
   const RirSet explicit_len = load_soundspaces(root, o);
   EXPECT_EQ(explicit_len.max_len, 81);
@@ -264,7 +264,7 @@ TEST(SoundSpaces, EmptyWavIsSilence) {
   SoundSpacesScene scene;
   scene.write(dir.path());
   testing::write_empty_wav(scene.wav(dir.path(), scene.entries[6]), 44100, 2);
-  const RirSet set = load_soundspaces(dir.path(), quiet());
+  const RirSet set = load_soundspaces(dir.path(), quiet_rirs());
   const torch::Tensor f = set.features(6);
   EXPECT_EQ(set.rirs[6].num_frames, 35);
   EXPECT_TRUE(torch::all(f == std::log(1e-3f)).item<bool>());
@@ -275,7 +275,7 @@ TEST(SoundSpaces, SplitAtSceneRootIsAcceptedAndMissingSplitIsAnError) {
   TempDir dir;
   SoundSpacesScene scene;
   scene.write(dir.path(), /*split_in_metadata=*/false);
-  RirLoadOptions o = quiet();
+  RirLoadOptions o = quiet_rirs();
   o.load_features = false;
   EXPECT_EQ(load_soundspaces(dir.path(), o).size(), 7);
   fs::remove(dir / "split.json");
@@ -303,13 +303,13 @@ TEST(FeatureCache, ReusedWhenValidRebuiltWhenAFileChanges) {
   TempDir dir;
   SoundSpacesScene scene;
   scene.write(dir.path());
-  const RirSet a = load_soundspaces(dir.path(), quiet());
+  const RirSet a = load_soundspaces(dir.path(), quiet_rirs());
   ASSERT_TRUE(fs::exists(a.cache_path));
   EXPECT_EQ(fs::path(a.cache_path).parent_path(), fs::path(dir / ".neraf_cache"));
   const auto stamp = fs::last_write_time(a.cache_path);
   const torch::Tensor f0 = a.features(0);
 
-  const RirSet b = load_soundspaces(dir.path(), quiet());
+  const RirSet b = load_soundspaces(dir.path(), quiet_rirs());
   EXPECT_EQ(b.cache_path, a.cache_path);
   EXPECT_EQ(fs::last_write_time(b.cache_path), stamp);  // not rewritten
   EXPECT_TRUE(torch::equal(b.features(0), f0));
@@ -320,7 +320,7 @@ TEST(FeatureCache, ReusedWhenValidRebuiltWhenAFileChanges) {
                                         testing::decaying_noise(20001, 44100, 0.1, 78)};
   testing::write_wav(wav, 44100, other);
   fs::last_write_time(wav, fs::last_write_time(wav) + std::chrono::seconds(5));
-  const RirSet c = load_soundspaces(dir.path(), quiet());
+  const RirSet c = load_soundspaces(dir.path(), quiet_rirs());
   EXPECT_NE(c.cache_path, a.cache_path);
   EXPECT_FALSE(fs::exists(a.cache_path));
   float mn = 0;
@@ -331,12 +331,12 @@ TEST(FeatureCache, ReusedWhenValidRebuiltWhenAFileChanges) {
 
   // A truncated cache file is detected and rebuilt.
   fs::resize_file(c.cache_path, fs::file_size(c.cache_path) - 100);
-  const RirSet d = load_soundspaces(dir.path(), quiet());
+  const RirSet d = load_soundspaces(dir.path(), quiet_rirs());
   EXPECT_EQ(d.cache_path, c.cache_path);
   EXPECT_TRUE(torch::equal(d.features(3), c.features(3)));
 
   // A user cache folder.
-  RirLoadOptions o = quiet();
+  RirLoadOptions o = quiet_rirs();
   TempDir cache_dir;
   o.cache_dir = cache_dir.path();
   const RirSet e = load_soundspaces(dir.path(), o);
@@ -348,7 +348,7 @@ TEST(FeatureCache, GatherReturnsTheRequestedSlices) {
   TempDir dir;
   SoundSpacesScene scene;
   scene.write(dir.path());
-  const RirSet set = load_soundspaces(dir.path(), quiet());
+  const RirSet set = load_soundspaces(dir.path(), quiet_rirs());
   torch::manual_seed(1);
   const int64_t b = 700;
   const torch::Tensor rir = torch::randint(0, set.size(), {b}, torch::kInt64);
@@ -375,7 +375,7 @@ TEST(FeatureCache, ACacheTruncatedWhileInUseIsAClearError) {
   TempDir dir;
   SoundSpacesScene scene;
   scene.write(dir.path());
-  const RirSet set = load_soundspaces(dir.path(), quiet());
+  const RirSet set = load_soundspaces(dir.path(), quiet_rirs());
   const torch::Tensor last = set.features(set.size() - 1);
   ASSERT_EQ(::truncate(set.cache_path.c_str(), fs::file_size(set.cache_path) / 2), 0);
   EXPECT_TRUE(torch::equal(set.features(0), set.features(0)));  // the first half is still there
@@ -388,7 +388,7 @@ TEST(FeatureCache, ACacheTruncatedWhileInUseIsAClearError) {
     EXPECT_NE(what.find("delete the file"), std::string::npos) << what;
   }
   // The next load sees a broken file and rebuilds it.
-  const RirSet again = load_soundspaces(dir.path(), quiet());
+  const RirSet again = load_soundspaces(dir.path(), quiet_rirs());
   EXPECT_TRUE(torch::equal(again.features(again.size() - 1), last));
 }
 
@@ -398,7 +398,7 @@ TEST(Raf, PosesYawSplitsFeaturesAndWaveforms) {
   TempDir dir;
   RafRoom room;
   room.write(dir.path());
-  const RirSet set = load_rir_set(dir.path(), quiet());
+  const RirSet set = load_rir_set(dir.path(), quiet_rirs());
   EXPECT_EQ(set.layout, AudioLayout::raf);
   ASSERT_EQ(set.size(), 6);
   EXPECT_EQ(set.train.size(), 4u);  // ['train'][0]
@@ -446,7 +446,7 @@ TEST(Raf, MaxLenOtherThanThePublished60IsRefused) {
   TempDir dir;
   RafRoom room;
   room.write(dir.path());
-  RirLoadOptions o = quiet();
+  RirLoadOptions o = quiet_rirs();
   o.max_len = 60;
   EXPECT_EQ(load_raf(dir.path(), o).max_len, 60);
   o.max_len = 80;
@@ -464,13 +464,13 @@ TEST(Raf, StringIdsAndWrongSampleRate) {
   room.write(dir.path());
   testing::write_text(dir / "metadata/data-split.json",
                       R"({"train": [["000000", "1", "000002"]], "test": [["000005"]]})");
-  const RirSet set = load_raf(dir.path(), quiet());
+  const RirSet set = load_raf(dir.path(), quiet_rirs());
   ASSERT_EQ(set.size(), 4);
   EXPECT_EQ(set.rirs[1].id, "000001");
 
   testing::write_wav(dir / "data/000002/rir.wav", 16000, {room.audio(2)});
   try {
-    load_raf(dir.path(), quiet());
+    load_raf(dir.path(), quiet_rirs());
     FAIL() << "expected a sample-rate error";
   } catch (const Error& e) {
     const std::string msg = e.what();

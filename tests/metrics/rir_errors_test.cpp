@@ -14,7 +14,7 @@
 namespace neraf::metrics {
 namespace {
 
-std::vector<float> decaying_noise(double t60, double fs, double seconds, uint32_t seed) {
+std::vector<float> decaying_test_noise(double t60, double fs, double seconds, uint32_t seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(-0.5f, 0.5f);
   const size_t n = static_cast<size_t>(seconds * fs);
@@ -49,7 +49,7 @@ TEST(T60Error, AnyInvalidValueScoresOneHundredPercent) {
 
 TEST(CompareRirs, IdenticalSignalsHaveZeroErrors) {
   const double fs = 22050;
-  io::AudioBuffer gt{int(fs), {decaying_noise(0.4, fs, 1.0, 1), decaying_noise(0.5, fs, 1.0, 2)}};
+  io::AudioBuffer gt{int(fs), {decaying_test_noise(0.4, fs, 1.0, 1), decaying_test_noise(0.5, fs, 1.0, 2)}};
   for (Variant v : {Variant::soundspaces, Variant::raf}) {
     const RirErrors e = compare_rirs(gt, gt, v);
     EXPECT_EQ(e.t60_error_pct, 0.0);
@@ -62,10 +62,10 @@ TEST(CompareRirs, IdenticalSignalsHaveZeroErrors) {
 
 TEST(CompareRirs, CombinesPerChannelMeasurements) {
   const double fs = 22050;
-  const std::vector<float> g0 = decaying_noise(0.4, fs, 1.0, 1),
-                           g1 = decaying_noise(0.5, fs, 1.0, 2);
-  const std::vector<float> p0 = decaying_noise(0.3, fs, 1.0, 3),
-                           p1 = decaying_noise(0.6, fs, 1.0, 4);
+  const std::vector<float> g0 = decaying_test_noise(0.4, fs, 1.0, 1),
+                           g1 = decaying_test_noise(0.5, fs, 1.0, 2);
+  const std::vector<float> p0 = decaying_test_noise(0.3, fs, 1.0, 3),
+                           p1 = decaying_test_noise(0.6, fs, 1.0, 4);
   const io::AudioBuffer gt{int(fs), {g0, g1}}, pred{int(fs), {p0, p1}};
   const RirErrors e = compare_rirs(pred, gt, Variant::soundspaces);
   const auto tp0 = measure_t60(p0, fs, 30.0).seconds, tg0 = measure_t60(g0, fs, 30.0).seconds;
@@ -92,7 +92,7 @@ TEST(CompareRirs, CombinesPerChannelMeasurements) {
 
 TEST(CompareRirs, SilentPredictionIsInvalidNotACrash) {
   const double fs = 22050;
-  const io::AudioBuffer gt{int(fs), {decaying_noise(0.4, fs, 1.0, 1)}};
+  const io::AudioBuffer gt{int(fs), {decaying_test_noise(0.4, fs, 1.0, 1)}};
   const io::AudioBuffer pred{int(fs), {std::vector<float>(100, 0.0f)}};  // also shorter: padded
   const RirErrors e = compare_rirs(pred, gt, Variant::raf);
   EXPECT_TRUE(e.invalid_t60);
@@ -104,7 +104,7 @@ TEST(CompareRirs, SilentPredictionIsInvalidNotACrash) {
 
 TEST(CompareRirs, PredictionIsZeroPaddedToTheGroundTruthLength) {
   const double fs = 22050;
-  const std::vector<float> g = decaying_noise(0.3, fs, 0.8, 5);
+  const std::vector<float> g = decaying_test_noise(0.3, fs, 0.8, 5);
   std::vector<float> shorter(g.begin(), g.begin() + g.size() - 700);
   std::vector<float> padded = shorter;
   padded.resize(g.size(), 0.0f);
@@ -120,7 +120,7 @@ TEST(CompareRirs, PredictionIsZeroPaddedToTheGroundTruthLength) {
 }
 
 TEST(CompareRirs, MismatchedLayoutsNameBothFiles) {
-  const std::vector<float> h = decaying_noise(0.3, 22050, 0.5, 1);
+  const std::vector<float> h = decaying_test_noise(0.3, 22050, 0.5, 1);
   const io::AudioBuffer mono{22050, {h}}, stereo{22050, {h, h}}, other_rate{48000, {h}};
   for (const io::AudioBuffer* p : {&stereo, &other_rate}) {
     try {
@@ -145,7 +145,7 @@ TEST(StftError, FramesFollowTheReferenceMaxLen) {
 }
 
 TEST(StftError, ZeroForIdenticalSignals) {
-  const std::vector<float> h = decaying_noise(0.3, 48000, 0.32, 9);
+  const std::vector<float> h = decaying_test_noise(0.3, 48000, 0.32, 9);
   EXPECT_EQ(stft_error(h, h, dsp::StftParams::raf(), 60), 0.0);
   EXPECT_EQ(stft_error(h, h, dsp::StftParams::soundspaces(), 10), 0.0);
 }
@@ -171,7 +171,7 @@ TEST(StftError, ScaledSignalMatchesTheFormula) {
   // pred = 4·gt: a power-of-two scale commutes exactly with the float FFT, so |STFT(pred)| =
   // 4·|STFT(gt)| bit for bit and the error is mean |log(4|X| + 1e-3) − log(|X| + 1e-3)|.
   const dsp::StftParams p = dsp::StftParams::raf();
-  const std::vector<float> gt = decaying_noise(0.2, 48000, 0.32, 11);
+  const std::vector<float> gt = decaying_test_noise(0.2, 48000, 0.32, 11);
   std::vector<float> pred(gt);
   for (float& v : pred) v *= 4.0f;
   const int frames = stft_error_frames(gt.size(), p);

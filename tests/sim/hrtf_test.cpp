@@ -6,15 +6,12 @@
 #include <fstream>
 
 #include "neraf/util/error.h"
+#include "rir_test_util.h"
 
 namespace neraf::sim {
 namespace {
 
-double energy(const std::vector<float>& x) {
-  double e = 0;
-  for (float v : x) e += double(v) * v;
-  return e;
-}
+using testing::energy;
 
 size_t first_above(const std::vector<float>& x, double fraction) {
   float peak = 0;

@@ -28,7 +28,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-fs::path temp_dir(const std::string& name) {
+fs::path synth_temp_dir(const std::string& name) {
   auto d = fs::temp_directory_path() / ("neraf_synth_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(d);
   return d;
@@ -98,7 +98,7 @@ void expect_png(const fs::path& path, int w, int h) {
 
 TEST(LayoutSynth, SoundSpacesFilesNamesAndFormats) {
   const Scene scene = small_scene();
-  const fs::path out = temp_dir("ss");
+  const fs::path out = synth_temp_dir("ss");
   const SynthSummary sum = synthesize(scene, options(out, 5, "soundspaces"));
   const auto mics = grid_microphone_positions(scene);
   ASSERT_EQ(mics.size(), 8u);  // 3 × 3 grid minus the point inside the box
@@ -198,7 +198,7 @@ TEST(LayoutSynth, RafFilesNamesAndFormats) {
   cardioid.yaw_deg = 90;
   cardioid.directivity = "cardioid";
   scene.sources.push_back(cardioid);
-  const fs::path out = temp_dir("raf");
+  const fs::path out = synth_temp_dir("raf");
   const SynthSummary sum = synthesize(scene, options(out, 9, "raf"));
   ASSERT_EQ(sum.num_rirs, 12);  // 6 random microphones × 2 sources
   EXPECT_EQ(sum.channels, 1);
@@ -252,7 +252,7 @@ TEST(LayoutSynth, RafFilesNamesAndFormats) {
 
 TEST(LayoutSynth, SameSeedGivesByteIdenticalFilesAtAnyThreadCount) {
   const Scene scene = small_scene();
-  const fs::path a = temp_dir("det_a"), b = temp_dir("det_b"), c = temp_dir("det_c");
+  const fs::path a = synth_temp_dir("det_a"), b = synth_temp_dir("det_b"), c = synth_temp_dir("det_c");
   const int saved = omp_get_max_threads();
   omp_set_num_threads(2);
   synthesize(scene, options(a, 11, "soundspaces"));
@@ -280,7 +280,7 @@ TEST(LayoutSynth, AGivenGainScalesTheWholeSet) {
   Scene scene = small_scene();
   scene.cameras.train_count = 1;
   scene.cameras.eval_count = 0;
-  const fs::path a = temp_dir("gain_auto"), b = temp_dir("gain_fixed");
+  const fs::path a = synth_temp_dir("gain_auto"), b = synth_temp_dir("gain_fixed");
   const SynthSummary automatic = synthesize(scene, options(a, 2, "raf"));
   SynthOptions fixed = options(b, 2, "raf");
   fixed.gain = 3 * automatic.gain;
@@ -301,7 +301,7 @@ TEST(LayoutSynth, GainFromChecksTheRoomAndThePlausibleRange) {
   Scene scene = small_scene();
   scene.cameras.train_count = 1;
   scene.cameras.eval_count = 0;
-  const fs::path a = temp_dir("gain_from");
+  const fs::path a = synth_temp_dir("gain_from");
   const SynthSummary written = synthesize(scene, options(a, 2, "raf"));
   EXPECT_DOUBLE_EQ(synthesized_gain(a.string()).value(), written.gain);
   EXPECT_FALSE(room_difference(scene, a.string()).has_value());
@@ -334,7 +334,7 @@ TEST(LayoutSynth, ARoomWhereNoSoundArrivesInTimeIsRefusedBeforeWriting) {
     EXPECT_EQ(std::string(e.what()).rfind("scene \"small\": every RIR would be silent", 0), 0u)
         << e.what();
   }
-  const fs::path out = temp_dir("silent");
+  const fs::path out = synth_temp_dir("silent");
   fs::remove_all(out);
   EXPECT_THROW(synthesize(scene, options(out, 2, "raf")), Error);
   EXPECT_FALSE(fs::exists(out));
@@ -346,7 +346,7 @@ TEST(LayoutSynth, RefusesANonEmptyFolderUnlessForced) {
   Scene scene = small_scene();
   scene.cameras.train_count = 1;
   scene.cameras.eval_count = 0;
-  const fs::path out = temp_dir("force");
+  const fs::path out = synth_temp_dir("force");
   fs::create_directories(out);
   io::write_text_atomically((out / "notes.txt").string(), "keep me");
   try {
@@ -402,12 +402,12 @@ TEST(LayoutSynth, RefusesANonEmptyFolderUnlessForced) {
   failing.hrtf_path = bad_hrtf.string();
   EXPECT_THROW(synthesize(binaural, failing), Error);
   EXPECT_TRUE(fs::exists(out / "data/000000/rir.wav"));
-  const fs::path fresh = temp_dir("fails_fresh");
+  const fs::path fresh = synth_temp_dir("fails_fresh");
   failing.out_dir = fresh.string();
   EXPECT_THROW(synthesize(binaural, failing), Error);
   EXPECT_FALSE(fs::exists(fresh) && !fs::is_empty(fresh));
   fs::remove(bad_hrtf);
-  EXPECT_THROW(synthesize(scene, options(temp_dir("bad_layout"), 1, "nerf")), Error);
+  EXPECT_THROW(synthesize(scene, options(synth_temp_dir("bad_layout"), 1, "nerf")), Error);
   fs::remove_all(out);
 }
 

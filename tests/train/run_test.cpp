@@ -24,14 +24,14 @@ using namespace neraf::eval;
 
 namespace {
 
-struct TempDir {
+struct RunTempDir {
   fs::path path;
-  explicit TempDir(const std::string& tag) {
+  explicit RunTempDir(const std::string& tag) {
     path = fs::temp_directory_path() / ("neraf_run_test_" + tag + "_" + std::to_string(::getpid()));
     fs::remove_all(path);
     fs::create_directories(path);
   }
-  ~TempDir() {
+  ~RunTempDir() {
     std::error_code ec;
     fs::remove_all(path, ec);
   }
@@ -71,7 +71,7 @@ void write_dataset(const fs::path& dir, const neraf::data::ImageSet& set) {
 }  // namespace
 
 TEST(Run, TrainResumeRefuseAndLoad) {
-  TempDir tmp("a");
+  RunTempDir tmp("a");
   const fs::path data = tmp.path / "data", run = tmp.path / "run";
   write_dataset(data, fixtures::make_image_set(3, 12));  // SSIM needs >= 11 px
   TrainConfig cfg = fixtures::tiny_train_config();
@@ -138,7 +138,7 @@ TEST(Run, TrainResumeRefuseAndLoad) {
 }
 
 TEST(Run, KeepsTheNewestRefusesASecondWriterAndSkipsDamagedCheckpoints) {
-  TempDir tmp("keep");
+  RunTempDir tmp("keep");
   const fs::path data = tmp.path / "data", run = tmp.path / "run";
   write_dataset(data, fixtures::make_image_set(3, 12));
   TrainConfig cfg = fixtures::tiny_train_config();
