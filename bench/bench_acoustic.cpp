@@ -85,10 +85,11 @@ void BM_ResNet3dFwdBwd(benchmark::State& state) {
   set_label(state, preset, false);
 }
 
-// The same fwd+bwd in six variants (issue 14 §4: where can ResNet3D's step go faster?): fp32 or
-// bf16 weights and grid (bit 0) or fp32 ones under CPU autocast to bf16 (bit 2: convolutions in
-// bf16, batch norm in fp32), contiguous (NCDHW) or channels-last (NDHWC, bit 1) tensors. Counters: the
-// features' and the grid gradient's relative error (L2) against fp32 contiguous.
+// The same fwd+bwd in other number formats and layouts (issue 14 §4: where can ResNet3D's step go
+// faster?), variant bits: 1 bf16 weights and grid, 2 channels-last (NDHWC) instead of NCDHW,
+// 4 fp32 under CPU autocast to bf16 (bf16 convolutions, fp32 batch norm), 8 fp64 (how exact fp32
+// itself is). Counters: the features' and the grid gradient's relative L2 error against fp32
+// NCDHW with the same weights and grid.
 void BM_ResNet3dLayouts(benchmark::State& state) {
   const int64_t preset = state.range(0);
   const bool bf16 = state.range(1) & 1, channels_last = state.range(1) & 2,
@@ -99,8 +100,8 @@ void BM_ResNet3dLayouts(benchmark::State& state) {
   ResNet3d reference(o.resnet);
   torch::manual_seed(0);
   ResNet3d net(o.resnet);
-  const auto format = channels_last ? torch::MemoryFormat::ChannelsLast3d
-                                    : torch::MemoryFormat::Contiguous;
+  const auto format =
+      channels_last ? torch::MemoryFormat::ChannelsLast3d : torch::MemoryFormat::Contiguous;
   const auto dtype = bf16 ? torch::kBFloat16 : fp64 ? torch::kFloat64 : torch::kFloat32;
   net->to(dtype);
   for (auto& p : net->parameters()) {
@@ -136,7 +137,10 @@ void BM_ResNet3dLayouts(benchmark::State& state) {
   state.counters["feature_rel_err"] = relative(y.detach(), y_ref.detach());
   state.counters["grid_grad_rel_err"] = relative(grid.grad(), grid_ref.grad());
   state.SetLabel(std::string(preset_name(preset)) +
-                 (bf16 ? "/bf16" : autocast ? "/autocast-bf16" : fp64 ? "/fp64" : "/fp32") +
+                 (bf16       ? "/bf16"
+                  : autocast ? "/autocast-bf16"
+                  : fp64     ? "/fp64"
+                             : "/fp32") +
                  (channels_last ? "/channels-last" : "/contiguous") +
                  " threads=" + std::to_string(torch::get_num_threads()));
 }

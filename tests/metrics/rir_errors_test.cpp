@@ -49,7 +49,8 @@ TEST(T60Error, AnyInvalidValueScoresOneHundredPercent) {
 
 TEST(CompareRirs, IdenticalSignalsHaveZeroErrors) {
   const double fs = 22050;
-  io::AudioBuffer gt{int(fs), {decaying_test_noise(0.4, fs, 1.0, 1), decaying_test_noise(0.5, fs, 1.0, 2)}};
+  io::AudioBuffer gt{int(fs),
+                     {decaying_test_noise(0.4, fs, 1.0, 1), decaying_test_noise(0.5, fs, 1.0, 2)}};
   for (Variant v : {Variant::soundspaces, Variant::raf}) {
     const RirErrors e = compare_rirs(gt, gt, v);
     EXPECT_EQ(e.t60_error_pct, 0.0);

@@ -252,7 +252,8 @@ TEST(LayoutSynth, RafFilesNamesAndFormats) {
 
 TEST(LayoutSynth, SameSeedGivesByteIdenticalFilesAtAnyThreadCount) {
   const Scene scene = small_scene();
-  const fs::path a = synth_temp_dir("det_a"), b = synth_temp_dir("det_b"), c = synth_temp_dir("det_c");
+  const fs::path a = synth_temp_dir("det_a"), b = synth_temp_dir("det_b"),
+                 c = synth_temp_dir("det_c");
   const int saved = omp_get_max_threads();
   omp_set_num_threads(2);
   synthesize(scene, options(a, 11, "soundspaces"));
