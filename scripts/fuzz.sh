@@ -74,6 +74,7 @@ if [ "${NERAF_FUZZ_PREBUILT:-0}" != 1 ]; then
   [ -f "$build/CMakeCache.txt" ] || generator_args=("${generator[@]}")
   cmake -S . -B "$build" "${generator_args[@]+"${generator_args[@]}"}" -DNERAF_FUZZ=ON \
     -DNERAF_WITH_TORCH=OFF -DNERAF_TESTS=OFF -DNERAF_BENCH=OFF -DNERAF_NATIVE=OFF \
+    -DCMAKE_UNITY_BUILD=ON -DCMAKE_UNITY_BUILD_BATCH_SIZE=8 \
     -DCMAKE_BUILD_TYPE=Debug -DCMAKE_C_COMPILER="$cc" -DCMAKE_CXX_COMPILER="$cxx" >/dev/null
   cmake --build "$build" --target neraf_fuzz -j "${NERAF_FUZZ_JOBS:-2}"
 fi
