@@ -3,12 +3,10 @@
 // Shapes: SoundSpaces (C = 2, F = 257, max_len = 78 frames). Presets cpu (32³ grid, small ResNet,
 // NAcF 5×512) and paper (128³, ResNet3D-50/layer3, NAcF 1187→5096→…→512), fp32 and bf16 NAcF trunk.
 //
-//   build-x/neraf_bench_acoustic                      # writes bench/results/acoustic.json
-//   build-x/neraf_bench_acoustic --benchmark_filter=cpu
-// Without --benchmark_out the JSON goes to <repo>/bench/results/acoustic.json.
+//   build/neraf_bench_acoustic --benchmark_out=build/bench/acoustic.json
+//   build/neraf_bench_acoustic --benchmark_filter=cpu
 #include <ATen/autocast_mode.h>
 #include <benchmark/benchmark.h>
-#include <malloc.h>
 #include <torch/torch.h>
 
 #include <algorithm>
@@ -16,6 +14,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_main.h"
 #include "neraf/acoustic/acoustic_model.h"
 #include "neraf/acoustic/losses.h"
 
@@ -284,26 +283,7 @@ NERAF_PAPER(BM_RenderStftCachedFeature, 1);
 }  // namespace neraf::acoustic
 
 int main(int argc, char** argv) {
-  // As the neraf program: all cores (LibTorch's default here is 1 thread) and no mmap churn.
+  // As the neraf program: all cores (LibTorch's default here is 1 thread).
   torch::set_num_threads(static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
-  mallopt(M_MMAP_MAX, 0);
-  mallopt(M_TRIM_THRESHOLD, 1 << 30);
-  std::vector<char*> args(argv, argv + argc);
-  bool has_out = false;
-  for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]).rfind("--benchmark_out=", 0) == 0) has_out = true;
-  }
-  std::string out =
-      std::string("--benchmark_out=") + NERAF_ASSETS_DIR + "/../bench/results/acoustic.json";
-  std::string fmt = "--benchmark_out_format=json";
-  if (!has_out) {
-    args.push_back(out.data());
-    args.push_back(fmt.data());
-  }
-  int n = static_cast<int>(args.size());
-  benchmark::Initialize(&n, args.data());
-  if (benchmark::ReportUnrecognizedArguments(n, args.data())) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return neraf::bench::run_benchmarks(argc, argv);
 }

@@ -2,10 +2,10 @@
 // auralization convolution. Inputs are random but seeded.
 //   neraf_bench_dsp --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
-#include <malloc.h>
 
 #include <random>
 
+#include "bench_main.h"
 #include "neraf/dsp/convolve.h"
 #include "neraf/dsp/griffin_lim.h"
 #include "neraf/dsp/stft.h"
@@ -98,14 +98,4 @@ BENCHMARK(BM_ConvolveRir1sAudio10s)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  // The heap settings of the neraf program (src/neraf/cli/main.cpp): freed buffers stay in the
-  // heap instead of being unmapped, so repeated calls do not page-fault; timings match the program.
-  mallopt(M_MMAP_MAX, 0);
-  mallopt(M_TRIM_THRESHOLD, 1 << 30);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}
+int main(int argc, char** argv) { return neraf::bench::run_benchmarks(argc, argv); }

@@ -8,11 +8,11 @@
 // Run: neraf_bench_nerf --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 //        --benchmark_out_format=json --benchmark_out=bench/results/nerf_ops.json
 #include <benchmark/benchmark.h>
-#include <malloc.h>
 #include <torch/torch.h>
 
 #include <cstdint>
 
+#include "bench_main.h"
 #include "neraf/nerf/hash_grid.h"
 #include "neraf/nerf/sh_encoding.h"
 
@@ -182,13 +182,4 @@ BENCHMARK_CAPTURE(sh_fwd_bwd, reference_196k, true) NERAF_THREADS;
 }  // namespace
 }  // namespace neraf::nerf
 
-int main(int argc, char** argv) {
-  // Large per-iteration tensors would otherwise go through mmap/munmap (page faults every step).
-  mallopt(M_MMAP_MAX, 0);
-  mallopt(M_TRIM_THRESHOLD, 1 << 30);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}
+int main(int argc, char** argv) { return neraf::bench::run_benchmarks(argc, argv); }

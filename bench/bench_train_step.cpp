@@ -9,12 +9,12 @@
 // DIR: a SoundSpaces-layout dataset (`neraf synth --preset demo --out DIR`); bench/train_step.sh
 // makes one and runs every case in its own process (the heap left by one slows the next).
 #include <benchmark/benchmark.h>
-#include <malloc.h>
 #include <torch/torch.h>
 
 #include <cstdlib>
 #include <string>
 
+#include "bench_main.h"
 #include "neraf/data/image_set.h"
 #include "neraf/data/rir_set.h"
 #include "neraf/infer/train_config.h"
@@ -73,14 +73,4 @@ NERAF_TRAIN_STEP(paper, vision, 10.0);
 NERAF_TRAIN_STEP(paper, zeros, 20.0);
 NERAF_TRAIN_STEP(paper, joint, 20.0);
 
-int main(int argc, char** argv) {
-  // As the neraf program (cli/main.cpp): large per-step tensors would otherwise go through
-  // mmap/munmap, with page faults every step.
-  mallopt(M_MMAP_MAX, 0);
-  mallopt(M_TRIM_THRESHOLD, 1 << 30);
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}
+int main(int argc, char** argv) { return neraf::bench::run_benchmarks(argc, argv); }
