@@ -19,8 +19,12 @@
 #                                     (checks the script end to end in minutes; its numbers mean
 #                                     nothing)
 #   EXPERIMENTS="1 3" scripts/...     only these experiments (the report covers what exists)
+#   E1_ROOMS="raf_furnished" ...      experiment 1 on these of its rooms only (default: both,
+#                                     ss_demo raf_furnished)
 #   E2_ROOMS="occluded" scripts/...   experiment 2 on these of its rooms only (default: all three,
 #                                     occluded raf_furnished raf_empty)
+#   E4_VIEWS="10" scripts/...         experiment 4 with these training-view counts only (default:
+#                                     10 20 40)
 # Runs are kept in build/experiments/ and skipped when their eval JSON exists, so an interrupted
 # run continues where it stopped (an unfinished training resumes from its last checkpoint).
 set -euo pipefail
@@ -111,9 +115,15 @@ for e in $EXPERIMENTS; do
   case $e in
     1)
       say "1/5 neraf vs the baselines (default neraf train, joint)"
-      room ss_demo --preset demo --layout soundspaces
-      room raf_furnished --preset furnished_room
-      for r in ss_demo raf_furnished; do
+      for r in ${E1_ROOMS:-ss_demo raf_furnished}; do
+        case $r in
+          ss_demo) room ss_demo --preset demo --layout soundspaces ;;
+          raf_furnished) room raf_furnished --preset furnished_room ;;
+          *)
+            echo "experiments: unknown E1_ROOMS room '$r' (use ss_demo, raf_furnished)" >&2
+            exit 2
+            ;;
+        esac
         for s in "${SEEDS[@]}"; do
           train "e1_${r}_s$s" --data "$OUT/data/$r" --seed "$s" "${JOINT[@]}"
           evaluate "e1_${r}_s$s" "e1_${r}_s$s" --novel-data "$OUT/data/${r}_novel" --skip-vision
@@ -168,7 +178,14 @@ for e in $EXPERIMENTS; do
     4)
       say "4/5 cross-modal vision with sparse images (10 / 20 / 40 training views)"
       room ss_demo --preset demo --layout soundspaces
-      for v in 10 20 40; do
+      for v in ${E4_VIEWS:-10 20 40}; do
+        case $v in
+          10 | 20 | 40) ;;
+          *)
+            echo "experiments: E4_VIEWS takes 10, 20 and 40 (the report's columns), not '$v'" >&2
+            exit 2
+            ;;
+        esac
         d=$OUT/data/ss_demo_views$v
         if [ ! -f "$d/transforms.json" ]; then
           # The same room, the same held-out views; only the first V training views listed.

@@ -10,9 +10,11 @@
 #include <fstream>
 
 #include "../infer/audio_test_util.h"
+#include "neraf/infer/audio_field.h"
 #include "neraf/infer/audio_run.h"
 #include "neraf/infer/calibration.h"
 #include "neraf/infer/checkpoint.h"
+#include "neraf/io/audio_file.h"
 #include "neraf/io/json_file.h"
 #include "neraf/train/trainer.h"
 #include "neraf/util/error.h"
@@ -94,9 +96,9 @@ TEST(AudioEval, RunFolderPredictsAndWritesJsonCsvPng) {
   o.num_images = 1;
   o.progress = false;
   const AudioEval e = evaluate_audio(ar, rirs, rirs.train, o);
-  ASSERT_EQ(e.methods.size(), 3u);
+  ASSERT_EQ(e.methods.size(), 4u);
   const nlohmann::json j = to_json(e);
-  for (const char* m : {"neraf", "nearest", "linear"})
+  for (const char* m : {"neraf", "nearest", "linear", kGriffinLimFloorName})
     for (const char* k :
          {"t60_error_pct", "c50_error_db", "edt_error_s", "stft_error", "invalid_t60", "n_rirs"})
       EXPECT_TRUE(j.at(m).contains(k)) << m << "." << k;
@@ -105,7 +107,7 @@ TEST(AudioEval, RunFolderPredictsAndWritesJsonCsvPng) {
   std::ifstream csv(o.out_dir + "/audio_per_rir.csv");
   int lines = 0;
   for (std::string l; std::getline(csv, l);) ++lines;
-  EXPECT_EQ(lines, 1 + 3 * 2);
+  EXPECT_EQ(lines, 1 + 4 * 2);
   EXPECT_TRUE(fs::exists(o.out_dir + "/audio_00000.png"));
   EXPECT_NE(audio_table(e.methods).find("nearest"), std::string::npos);
 
@@ -113,7 +115,7 @@ TEST(AudioEval, RunFolderPredictsAndWritesJsonCsvPng) {
   // prediction as the default split's path gives for them, baselines from the run's train set.
   const std::vector<int64_t> chosen = {rirs.train[0], rirs.train[1], rirs.train[2]};
   const AudioEval n = evaluate_audio(ar, rirs, {rirs.train[3]}, rirs, chosen, o);
-  ASSERT_EQ(n.methods.size(), 3u);
+  ASSERT_EQ(n.methods.size(), 4u);
   EXPECT_EQ(n.rir_ids.size(), 3u);
   EXPECT_EQ(n.rir_ids[1], rirs.rirs[static_cast<size_t>(chosen[1])].id);
   EXPECT_EQ(to_json(n)["linear"]["n_rirs"], 3);
@@ -160,13 +162,34 @@ TEST(AudioEval, UncalibratedRowIsTheRunWithoutItsCalibration) {
   o.neraf_post_processing = kCalibratedGriffinLim;
   o.uncalibrated = &uncalibrated;
   const AudioEval e = evaluate_audio(calibrated, rirs, rirs.train, o);
-  ASSERT_EQ(e.methods.size(), 4u);
+  ASSERT_EQ(e.methods.size(), 5u);
   EXPECT_EQ(e.methods[0].name, "neraf");
   EXPECT_EQ(e.methods[0].post_processing, kCalibratedGriffinLim);
   EXPECT_EQ(e.methods[1].name, kUncalibratedName);
   EXPECT_EQ(e.methods[1].post_processing, kGriffinLim);
   EXPECT_EQ(e.methods[2].post_processing, kMeasuredWaveform);  // nearest
   EXPECT_EQ(e.methods[3].post_processing, kGriffinLim);        // linear
+  EXPECT_EQ(e.methods[4].name, kGriffinLimFloorName);
+  EXPECT_EQ(e.methods[4].post_processing, kGriffinLim);
+
+  // The floor is each test RIR's own measured magnitudes through the same Griffin-Lim (the
+  // seed of every row for that RIR), scored against its waveform: recomputed here.
+  for (size_t n = 0; n < rirs.test.size(); ++n) {
+    const int64_t i = rirs.test[n];
+    const auto wave = infer::griffin_lim_channels(infer::log_stft_to_magnitude(rirs.features(i)),
+                                                  rirs.stft, o.seed + n);
+    io::AudioBuffer pred, gt;
+    pred.sample_rate = gt.sample_rate = rirs.sample_rate;
+    pred.channels = wave;
+    const torch::Tensor w = rirs.waveform(i).to(torch::kFloat32).contiguous();
+    for (int64_t c = 0; c < w.size(0); ++c)
+      gt.channels.emplace_back(w[c].data_ptr<float>(), w[c].data_ptr<float>() + w.size(1));
+    const metrics::RirErrors want =
+        metrics::compare_rirs(pred, gt, metrics::Variant::soundspaces, "floor", "gt");
+    EXPECT_EQ(e.methods[4].per_rir[n].stft_error, want.stft_error) << n;
+    EXPECT_EQ(e.methods[4].per_rir[n].c50_error_db, want.c50_error_db) << n;
+    EXPECT_EQ(e.methods[4].per_rir[n].t60_error_pct, want.t60_error_pct) << n;
+  }
 
   // The reference: the run loaded without its calibration, scored as the only model.
   const AudioMethodEval alone = evaluate_audio_model(uncalibrated, rirs, rirs.test, "neraf", o);

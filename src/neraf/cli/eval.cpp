@@ -104,7 +104,8 @@ struct Ablation {
 
 // The run, its baselines and the ablation runs on one set; prints the table under `title`, writes
 // the per-RIR CSV into opts.out_dir as `csv_name` → {"neraf", "neraf_uncalibrated", "nearest",
-// "linear", "paired", "paired_uncalibrated", "ablations", "paired_ablations"}.
+// "linear", "griffin_lim_floor", "paired", "paired_uncalibrated", "ablations",
+// "paired_ablations"}.
 nlohmann::json score_audio(const infer::AudioField& run, const std::vector<Ablation>& ablations,
                            const AudioEvalSet& set, const eval::AudioEvalOptions& opts,
                            const std::string& csv_name, const std::string& title,
@@ -145,10 +146,11 @@ nlohmann::json score_audio(const infer::AudioField& run, const std::vector<Ablat
       "%s (%s, %zu RIRs, %.1f s; per-RIR CSV %s):\n%s"
       "post-processing: %s = Griffin-Lim of the prediction with the run's energy calibration and "
       "early/late balance, fitted on its training RIRs; %s = Griffin-Lim of the magnitudes as "
-      "predicted or blended; %s = a training RIR as measured\n%s%s%s",
+      "predicted or blended (%s: the measured magnitudes, what a perfect prediction would score "
+      "through it); %s = a training RIR as measured\n%s%s%s",
       title.c_str(), data::to_string(set.test_set.layout), e.rir_ids.size(), e.seconds, csv.c_str(),
       eval::audio_table(e.methods).c_str(), eval::kCalibratedGriffinLim, eval::kGriffinLim,
-      eval::kMeasuredWaveform, eval::paired_table(e).c_str(),
+      eval::kGriffinLimFloorName, eval::kMeasuredWaveform, eval::paired_table(e).c_str(),
       eval::paired_table(e, eval::kUncalibratedName).c_str(),
       eval::paired_table(e, "neraf", labels).c_str());
   return out;
@@ -298,7 +300,7 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
                 "changed (e.g. --grid zeros)");
     const std::string label = std::filesystem::path(dir).lexically_normal().filename().string();
     require(labels.insert(label).second && label != "neraf" && label != eval::kUncalibratedName &&
-                label != "nearest" && label != "linear",
+                label != "nearest" && label != "linear" && label != eval::kGriffinLimFloorName,
             "--ablation-runs: two runs (or a run and a method) are called '" + label +
                 "' (each is labelled by its folder's name); give each its own folder name");
     ablations.push_back(
@@ -477,8 +479,9 @@ void register_eval(CLI::App& app) {
       "PSNR and SSIM follow nerfstudio's evaluation (torchmetrics semantics, mean over the\n"
       "eval views). The JSON has {\"run\", \"checkpoint\", \"step\", \"vision\": {\"psnr\",\n"
       "\"ssim\", \"n_views\", \"views\": [...]}, \"audio\": {\"neraf\"|\"neraf_uncalibrated\"|\n"
-      "\"nearest\"|\"linear\": {\"t60_error_pct\", \"c50_error_db\", \"edt_error_s\",\n"
-      "\"stft_error\", \"invalid_t60\", \"n_rirs\", \"*_std\", \"post_processing\"}, \"paired\",\n"
+      "\"nearest\"|\"linear\"|\"griffin_lim_floor\": {\"t60_error_pct\", \"c50_error_db\",\n"
+      "\"edt_error_s\", \"stft_error\", \"invalid_t60\", \"n_rirs\", \"*_std\",\n"
+      "\"post_processing\"}, \"paired\", "
       "\"paired_uncalibrated\", \"ablations\", \"paired_ablations\", \"novel\"}}. Audio follows\n"
       "NeRAF's evaluator: predicted log-STFT → Griffin-Lim (32 it., seeded) → T60/C50/EDT vs\n"
       "the measured waveform. A calibrated run (the cpu preset) is scored twice: \"neraf\" with\n"
@@ -489,7 +492,9 @@ void register_eval(CLI::App& app) {
       "modality, preset, steps, seed, data; else refused). Baselines:\n"
       "nearest = the measured RIR of the closest training mic with the same heading and source;\n"
       "linear = inverse-distance blend of the 2-4 closest such training RIRs' magnitudes +\n"
-      "Griffin-Lim. Side-by-side GT | prediction PNGs (images: eval_*.png; audio: audio_*.png\n"
+      "Griffin-Lim. griffin_lim_floor is not a method: the test RIR's own measured magnitudes\n"
+      "through the same Griffin-Lim, the error a perfect prediction would still have.\n"
+      "Side-by-side GT | prediction PNGs (images: eval_*.png; audio: audio_*.png\n"
       "prediction | GT log-STFT) and audio_per_rir.csv go to RUN/eval/ (or --images DIR).\n"
       "The test split holds out (source, heading) pairs at trained microphone positions;\n"
       "--novel-data scores new positions too (audio.novel).\n"
@@ -530,7 +535,8 @@ void register_eval(CLI::App& app) {
   cmd->add_flag("--quiet", args->quiet, "No progress bar");
   cmd->add_flag("--skip-vision", args->skip_vision, "Do not evaluate the images (audio only)");
   cmd->add_flag("--no-baselines", args->no_baselines,
-                "Audio: do not score the nearest-neighbour and linear-interpolation baselines");
+                "Audio: do not score the nearest-neighbour and linear-interpolation baselines "
+                "(nor the Griffin-Lim floor)");
   cmd->add_option("--max-rirs", args->max_rirs, "Audio: evaluate only the first N test RIRs")
       ->transform(whole_number(1, 100000000));
   args->cache_dir_opt = cmd->add_option(

@@ -16,6 +16,10 @@
 //            (an exact pose match, d < 1e-6, takes weight 1); the prediction is Griffin-Lim (same
 //            settings as neraf) of Σ w_i·mag_i, mag_i = clip(exp(logSTFT_i) − 1e-3, 0, 1e4) the
 //            training features (padded to max_len as for training).
+// And a reference row, not a method: griffin_lim_floor, the test RIR's own measured magnitudes
+// (its features, cut or padded to max_len as for training) through the same Griffin-Lim: what
+// a field that predicted every magnitude exactly would score. Every Griffin-Lim row's error
+// contains this floor; `nearest`, a measured waveform, does not.
 // Metrics per method: mean (and sample std) of t60_error_pct, c50_error_db, edt_error_s,
 // stft_error, and invalid_t60 (fraction of RIRs with an invalid T60), n_rirs.
 //
@@ -50,11 +54,13 @@ inline constexpr const char* kGriffinLim = "griffin_lim";              // GL of 
 inline constexpr const char* kMeasuredWaveform = "measured_waveform";  // a training RIR as it is
 // The name of the uncalibrated neraf row.
 inline constexpr const char* kUncalibratedName = "neraf_uncalibrated";
+// The name of the reference row: the measured magnitudes through Griffin-Lim.
+inline constexpr const char* kGriffinLimFloorName = "griffin_lim_floor";
 
 struct AudioEvalOptions {
   std::string out_dir;     // per-RIR CSV (audio_per_rir.csv) and PNGs (audio_XXX.png) here
   int64_t num_images = 4;  // predicted | ground-truth log-STFT PNGs for the first N test RIRs
-  bool baselines = true;   // also score nearest and linear
+  bool baselines = true;   // also score nearest, linear and griffin_lim_floor
   int64_t max_rirs = -1;   // only the first N test RIRs (−1: all)
   uint64_t seed = 0;       // Griffin-Lim initial phases
   bool progress = true;
@@ -69,7 +75,7 @@ struct AudioMethodEval {
   std::string name;  // "neraf", "nearest", "linear" or an ablation label
   std::vector<metrics::RirErrors> per_rir;
   metrics::RirErrorSummary summary;
-  double seconds = 0;  // wall time of the scoring (the two baselines: of both together)
+  double seconds = 0;  // wall time of the scoring (the baselines and the floor: of all together)
   std::string post_processing = kGriffinLim;  // kCalibratedGriffinLim, kGriffinLim, ...
 };
 
@@ -99,7 +105,7 @@ AudioMethodEval evaluate_audio_model(const infer::AudioField& run, const data::R
 //  "<key>_std" ...}
 nlohmann::json to_json(const metrics::RirErrorSummary& s);
 // {"neraf": {..., "seconds", "post_processing"}, "neraf_uncalibrated": {...}, "nearest": {...},
-//  "linear": {...}}
+//  "linear": {...}, "griffin_lim_floor": {...}}
 nlohmann::json to_json(const AudioEval& e);
 // Method `first` against each of `others` present in `e`, on the same RIRs
 // (metrics::paired_difference of the T60, C50 and EDT errors, first − other):
