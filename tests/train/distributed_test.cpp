@@ -1,6 +1,6 @@
 // Data-parallel training (train/distributed.h): the bucket plan, the sharded spectral-convergence
-// loss, and K joint steps with 2 ranks (threads of this process, Gloo over 127.0.0.1) against one
-// process with the same global batch.
+// loss, the gradient all-reduce inside the backward pass, and K joint steps with 2 ranks (threads
+// of this process, Gloo over 127.0.0.1) against one process with the same global batch.
 #include "neraf/train/distributed.h"
 
 #include <arpa/inet.h>
@@ -115,6 +115,97 @@ TEST(Distributed, ShardedSpectralConvergenceEqualsTheWholeBatch) {
             1e-6 * whole.grad().abs().max().item<double>());
 }
 
+// The all-reduce that overlaps the backward pass, against the mean of the ranks' gradients from a
+// plain backward: parameters reached several times, one in two optimizer groups (listed twice),
+// one the graph does not reach (keeps no gradient), one frozen, many small buckets, two steps
+// (the hooks serve every graph).
+TEST(Distributed, GradientsAreAveragedWhileBackwardRuns) {
+  struct Model {
+    torch::Tensor a, b, d, unused, frozen;
+    explicit Model(int seed) {
+      torch::manual_seed(seed);
+      a = torch::randn({300}).requires_grad_(true);
+      b = torch::randn({40, 50}).requires_grad_(true);
+      d = torch::randn({100}).requires_grad_(true);
+      unused = torch::randn({64}).requires_grad_(true);
+      frozen = torch::randn({100});
+    }
+    std::vector<torch::Tensor> params() const { return {a, b, d, b, unused, frozen}; }
+    torch::Tensor loss(int rank, int step) const {
+      torch::manual_seed(100 * step + rank);  // this rank's "batch"
+      const torch::Tensor x = torch::randn({300}), y = torch::randn({100});
+      return (a * x).pow(2).sum() + b.sum() * d.sum() + (d * y * frozen).sum() + b.pow(3).mean();
+    }
+  };
+  const int W = 2, steps = 2;
+  // The reference: each rank's gradients from a plain backward, averaged here.
+  std::vector<std::vector<torch::Tensor>> want(steps);
+  for (int s = 0; s < steps; ++s) {
+    std::vector<torch::Tensor> sum;
+    for (int r = 0; r < W; ++r) {
+      Model m(7);
+      m.loss(r, s).backward();
+      const std::vector<torch::Tensor> g = {m.a.grad(), m.b.grad(), m.d.grad()};
+      for (size_t i = 0; i < g.size(); ++i) {
+        if (r == 0)
+          sum.push_back(g[i].clone());
+        else
+          sum[i] += g[i];
+      }
+    }
+    for (auto& t : sum) want[static_cast<size_t>(s)].push_back(t / W);
+  }
+
+  const int port = free_port();
+  std::vector<std::vector<std::vector<torch::Tensor>>> got(W);
+  std::vector<CommStats> stats(W);
+  std::vector<std::string> errors(W);
+  auto rank_main = [&](int rank) {
+    try {
+      DistributedConfig dc;
+      dc.world_size = W;
+      dc.rank = rank;
+      dc.master_port = port;
+      dc.timeout_s = 30;
+      dc.bucket_bytes = 4000;  // a, d: one bucket each; b (8000 bytes): its own
+      Distributed dist(dc);
+      Model m(7);
+      for (int s = 0; s < steps; ++s) {
+        for (auto& p : m.params()) p.mutable_grad() = torch::Tensor();
+        dist.backward_and_average(m.loss(rank, s), m.params());
+        EXPECT_FALSE(m.unused.grad().defined());
+        EXPECT_FALSE(m.frozen.grad().defined());
+        got[rank].push_back({m.a.grad().clone(), m.b.grad().clone(), m.d.grad().clone()});
+      }
+      stats[rank] = dist.stats();
+      dist.barrier();
+    } catch (const std::exception& e) {
+      errors[rank] = e.what();
+    }
+  };
+  std::thread t0(rank_main, 0), t1(rank_main, 1);
+  t0.join();
+  t1.join();
+  for (int r = 0; r < W; ++r) {
+    ASSERT_EQ(errors[r], "") << "rank " << r;
+    ASSERT_EQ(got[r].size(), static_cast<size_t>(steps));
+    for (int s = 0; s < steps; ++s)
+      for (size_t i = 0; i < 3; ++i) {
+        const auto& g = got[r][s][i];
+        const auto& w = want[s][i];
+        EXPECT_LE((g - w).abs().max().item<double>(), 1e-6 * w.abs().max().item<double>())
+            << "rank " << r << " step " << s << " parameter " << i;
+      }
+    EXPECT_EQ(stats[r].allreduces, steps);
+    EXPECT_EQ(stats[r].buckets, 3 * steps);
+    // Every bucket's gradients were final before backward returned, so each started inside it.
+    EXPECT_EQ(stats[r].overlapped_buckets, stats[r].buckets);
+    EXPECT_EQ(stats[r].bytes, steps * (300 + 2000 + 100) * 4);
+  }
+  for (int s = 0; s < steps; ++s)
+    for (size_t i = 0; i < 3; ++i) EXPECT_TRUE(got[0][s][i].equal(got[1][s][i]));
+}
+
 // Every distinct parameter of the trainer's branches, cloned.
 std::vector<torch::Tensor> parameters_of(Trainer& t) {
   std::vector<torch::Tensor> out;
@@ -131,6 +222,7 @@ struct RunResult {
   std::vector<torch::Tensor> params;  // rank 0's after the steps
   std::vector<double> losses;         // rank 0's reported total loss per step
   double max_rank_difference = 0;     // largest |rank r − rank 0| over the parameters
+  CommStats comm;                     // rank 0's
 };
 
 RunResult train_ranks(const TrainConfig& cfg, int world, int steps, const data::ImageSet& images,
@@ -164,7 +256,10 @@ RunResult train_ranks(const TrainConfig& cfg, int world, int steps, const data::
       RunResult& out = results[static_cast<size_t>(rank)];
       for (int s = 0; s < steps; ++s) out.losses.push_back(trainer->step().loss);
       out.params = parameters_of(*trainer);
-      if (dist) dist->barrier();
+      if (dist) {
+        out.comm = dist->stats();
+        dist->barrier();
+      }
     } catch (...) {
       errors[static_cast<size_t>(rank)] = std::current_exception();
     }
@@ -210,6 +305,10 @@ TEST(Distributed, TwoRanksTrainWhatOneProcessTrainsOnTheSameGlobalBatch) {
   const RunResult two = train_ranks(cfg, 2, K, images, rirs, 4096);  // many small buckets
   // The ranks hold identical parameters (the same averaged gradients, the same Adam).
   EXPECT_EQ(two.max_rank_difference, 0.0);
+  // The trainer's all-reduces ran inside its backward passes (the last bucket may start after).
+  EXPECT_EQ(two.comm.allreduces, K);
+  EXPECT_GE(two.comm.overlapped_buckets, two.comm.buckets - K);
+  EXPECT_GT(two.comm.overlapped_buckets, 0);
   const double moved = max_difference(one.params, init);
   const double diff = max_difference(one.params, two.params);
   ASSERT_GT(moved, 1e-3);  // the steps did change the model

@@ -1,5 +1,8 @@
 #include "neraf/train/distributed.h"
 
+#include <torch/csrc/autograd/function.h>
+#include <torch/csrc/autograd/utils/lambda_post_hook.h>
+#include <torch/csrc/autograd/variable.h>
 #include <torch/torch.h>
 
 #include <algorithm>
@@ -9,6 +12,7 @@
 #include <torch/csrc/distributed/c10d/PrefixStore.hpp>
 #include <torch/csrc/distributed/c10d/ProcessGroupGloo.hpp>
 #include <torch/csrc/distributed/c10d/TCPStore.hpp>
+#include <unordered_map>
 #include <unordered_set>
 
 #include "neraf/infer/checkpoint.h"
@@ -113,8 +117,89 @@ struct Distributed::Impl {
   }
 };
 
+// backward_and_average's state. The hooks stay on the accumulators (kept alive here, so every
+// step's graph reaches the same ones) and act only while a step is active.
+struct Distributed::Overlap {
+  struct Hooked {
+    at::Tensor param;
+    std::shared_ptr<torch::autograd::Node> accumulator;
+    uintptr_t key = 0;  // the post-hook, for del_post_hook
+  };
+  std::vector<Hooked> hooked;
+  std::unordered_map<const void*, size_t> index;  // TensorImpl → hooked
+
+  // This step, set up before loss.backward():
+  bool active = false;
+  std::vector<int64_t> bucket_of;            // per hooked parameter: its bucket, −1 if none
+  std::vector<bool> arrived;                 // per hooked parameter: its gradient is final
+  std::vector<std::vector<size_t>> buckets;  // hooked indices
+  std::vector<int64_t> pending;              // per bucket: gradients still to come
+  size_t next = 0;                           // the first bucket not started
+  std::vector<std::vector<at::Tensor>> flats;
+  std::vector<c10::intrusive_ptr<c10d::Work>> works;
+  std::exception_ptr error;  // what starting an all-reduce threw inside the backward pass
+  int64_t started_in_backward = 0;
+  double seconds = 0;  // spent in the hooks
+
+  ~Overlap() {
+    for (Hooked& h : hooked) h.accumulator->del_post_hook(h.key);
+  }
+
+  // Starts bucket `b`: its gradients flattened (zeros for a parameter the graph reached that got
+  // none, identically on every rank), all-reduced by Gloo's threads.
+  void start(size_t b, c10d::ProcessGroupGloo& group, CommStats& stats) {
+    torch::NoGradGuard no_grad;
+    std::vector<at::Tensor> parts;
+    for (size_t i : buckets[b]) {
+      const at::Tensor& p = hooked[i].param;
+      const at::Tensor& g = p.grad();
+      parts.push_back(g.defined() ? g.reshape({-1}) : torch::zeros({p.numel()}, p.options()));
+    }
+    flats[b] = {torch::cat(parts)};
+    stats.bytes += flats[b][0].numel() * static_cast<int64_t>(flats[b][0].element_size());
+    works[b] = group.allreduce(flats[b]);
+  }
+
+  // A post-hook: parameter i's gradient is final; start every bucket that is complete, in order.
+  void arrive(size_t i, c10d::ProcessGroupGloo& group, CommStats& stats) {
+    if (!active || bucket_of[i] < 0 || arrived[i] || error) return;
+    const auto t0 = Clock::now();
+    arrived[i] = true;
+    --pending[static_cast<size_t>(bucket_of[i])];
+    try {
+      for (; next < buckets.size() && pending[next] == 0; ++next, ++started_in_backward)
+        start(next, group, stats);
+    } catch (...) {
+      error = std::current_exception();  // rethrown after backward, as neraf::Error
+    }
+    seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+  }
+};
+
+namespace {
+
+// The autograd nodes that backward from `loss` runs (the accumulators of the parameters it
+// reaches among them).
+std::unordered_set<const torch::autograd::Node*> graph_nodes(const at::Tensor& loss) {
+  std::unordered_set<const torch::autograd::Node*> seen;
+  std::vector<torch::autograd::Node*> todo;
+  if (torch::autograd::Node* root = loss.grad_fn().get()) {
+    seen.insert(root);
+    todo.push_back(root);
+  }
+  while (!todo.empty()) {
+    torch::autograd::Node* n = todo.back();
+    todo.pop_back();
+    for (const torch::autograd::Edge& e : n->next_edges())
+      if (e.function && seen.insert(e.function.get()).second) todo.push_back(e.function.get());
+  }
+  return seen;
+}
+
+}  // namespace
+
 Distributed::Distributed(const DistributedConfig& config)
-    : config_(config), impl_(std::make_unique<Impl>()) {
+    : config_(config), impl_(std::make_unique<Impl>()), overlap_(std::make_unique<Overlap>()) {
   const int W = config_.world_size, r = config_.rank;
   require(W >= 1, "--world-size: must be at least 1");
   require(r >= 0 && r < W, "--rank " + std::to_string(r) + ": must be below --world-size " +
@@ -304,46 +389,96 @@ void Distributed::broadcast(const std::vector<at::Tensor>& tensors) {
   }
 }
 
-void Distributed::average_gradients(const std::vector<at::Tensor>& params) {
-  const auto t0 = Clock::now();
-  // A parameter may sit in several optimizer groups; its one gradient is reduced once.
-  std::unordered_set<const void*> seen;
-  std::vector<at::Tensor> grads;
-  for (const auto& p : params) {
-    if (!seen.insert(p.unsafeGetTensorImpl()).second) continue;
-    const at::Tensor& g = p.grad();
-    if (g.defined()) grads.push_back(g);
+void Distributed::backward_and_average(const at::Tensor& loss,
+                                       const std::vector<at::Tensor>& params) {
+  Overlap& o = *overlap_;
+  c10d::ProcessGroupGloo* group = impl_->group.get();
+  CommStats* stats = &stats_;
+  // Each distinct parameter that takes gradients gets its hook once.
+  std::vector<size_t> order;  // hooked indices, in the order of `params`
+  for (const at::Tensor& p : params) {
+    if (!p.requires_grad()) continue;
+    auto [it, added] = o.index.emplace(p.unsafeGetTensorImpl(), o.hooked.size());
+    if (added) {
+      Overlap::Hooked h{p, torch::autograd::impl::grad_accumulator(p), 0};
+      const size_t i = it->second;
+      h.key = h.accumulator->add_post_hook(std::make_unique<torch::autograd::utils::LambdaPostHook>(
+          [&o, group, stats, i](const torch::autograd::variable_list& outputs,
+                                const torch::autograd::variable_list&) {
+            o.arrive(i, *group, *stats);
+            return outputs;
+          }));
+      o.hooked.push_back(std::move(h));
+    }
+    if (std::find(order.begin(), order.end(), it->second) == order.end())
+      order.push_back(it->second);
   }
+
+  // This step's buckets: the parameters the graph reaches, last first.
+  const auto t0 = Clock::now();
+  const auto nodes =
+      loss.requires_grad() ? graph_nodes(loss) : std::unordered_set<const torch::autograd::Node*>{};
+  std::vector<size_t> reached;
+  for (auto it = order.rbegin(); it != order.rend(); ++it)
+    if (nodes.count(o.hooked[*it].accumulator.get())) reached.push_back(*it);
+  std::vector<at::Tensor> tensors;
+  for (size_t i : reached) tensors.push_back(o.hooked[i].param);
+  o.buckets.clear();
+  for (const auto& bucket : plan_buckets(tensors, config_.bucket_bytes)) {
+    o.buckets.emplace_back();
+    for (size_t k : bucket) o.buckets.back().push_back(reached[k]);
+  }
+  o.bucket_of.assign(o.hooked.size(), -1);
+  o.arrived.assign(o.hooked.size(), false);
+  o.pending.assign(o.buckets.size(), 0);
+  for (size_t b = 0; b < o.buckets.size(); ++b)
+    for (size_t i : o.buckets[b]) {
+      o.bucket_of[i] = static_cast<int64_t>(b);
+      ++o.pending[b];
+    }
+  o.next = 0;
+  o.flats.assign(o.buckets.size(), {});
+  o.works.assign(o.buckets.size(), {});
+  o.error = nullptr;
+  o.started_in_backward = 0;
+  o.seconds = 0;
+  double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+
+  if (loss.requires_grad()) {
+    o.active = true;
+    try {
+      loss.backward();
+    } catch (...) {
+      o.active = false;
+      throw;
+    }
+    o.active = false;
+  }
+
+  const auto t1 = Clock::now();
   torch::NoGradGuard no_grad;
   try {
-    // Every bucket is flattened and its all-reduce started before the first is waited for, so
-    // Gloo's threads send one bucket while the next is being copied.
-    const auto buckets = plan_buckets(grads, config_.bucket_bytes);
-    std::vector<std::vector<at::Tensor>> flats(buckets.size());
-    std::vector<c10::intrusive_ptr<c10d::Work>> works;
-    for (size_t b = 0; b < buckets.size(); ++b) {
-      std::vector<at::Tensor> parts;
-      for (size_t i : buckets[b]) parts.push_back(grads[i].reshape({-1}));
-      flats[b] = {torch::cat(parts)};
-      stats_.bytes += flats[b][0].numel() * static_cast<int64_t>(flats[b][0].element_size());
-      works.push_back(impl_->group->allreduce(flats[b]));
-    }
-    for (size_t b = 0; b < buckets.size(); ++b) {
-      works[b]->wait(millis(config_.timeout_s));
-      at::Tensor flat = flats[b][0].div_(config_.world_size);
+    if (o.error) std::rethrow_exception(o.error);
+    for (; o.next < o.buckets.size(); ++o.next) o.start(o.next, *group, stats_);
+    for (size_t b = 0; b < o.buckets.size(); ++b) {
+      o.works[b]->wait(millis(config_.timeout_s));
+      const at::Tensor flat = o.flats[b][0].div_(config_.world_size);
       int64_t offset = 0;
-      for (size_t i : buckets[b]) {
-        const int64_t n = grads[i].numel();
-        grads[i].copy_(flat.narrow(0, offset, n).view(grads[i].sizes()));
+      for (size_t i : o.buckets[b]) {
+        at::Tensor g = o.hooked[i].param.grad();
+        const int64_t n = o.hooked[i].param.numel();
+        if (g.defined()) g.copy_(flat.narrow(0, offset, n).view(g.sizes()));
         offset += n;
       }
     }
-    stats_.buckets += static_cast<int64_t>(buckets.size());
   } catch (const std::exception& e) {
     fail("the gradient all-reduce", e);
   }
   stats_.allreduces += 1;
-  stats_.seconds += std::chrono::duration<double>(Clock::now() - t0).count();
+  stats_.buckets += static_cast<int64_t>(o.buckets.size());
+  stats_.overlapped_buckets += o.started_in_backward;
+  seconds += o.seconds + std::chrono::duration<double>(Clock::now() - t1).count();
+  stats_.seconds += seconds;
 }
 
 void Distributed::sum(at::Tensor& tensor) {

@@ -4,9 +4,10 @@
 //
 // Every rank holds the whole model. Each step every rank draws the same global batch from the
 // same (checkpointed) generator and works on its own contiguous slice of it (train/trainer.h,
-// StepContext::shard); the gradients are then averaged over the ranks (flattened buckets,
-// all-reduced asynchronously, waited before the optimizer steps), so the step equals one
-// process's step on the global batch up to float rounding. Rank 0 alone writes the run folder.
+// StepContext::shard); the gradients are then averaged over the ranks (flattened buckets whose
+// all-reduces start inside the backward pass as soon as their gradients are final, waited before
+// the optimizer steps), so the step equals one process's step on the global batch up to float
+// rounding. Rank 0 alone writes the run folder.
 //
 // Failures never hang: the rendezvous and every collective wait at most `timeout_s` (a rank that
 // died usually shows as "connection closed" at once); they become one neraf::Error line naming
@@ -49,8 +50,12 @@ std::vector<std::vector<size_t>> plan_buckets(const std::vector<at::Tensor>& ten
 struct CommStats {
   int64_t allreduces = 0;  // gradient all-reduce calls (one per step)
   int64_t buckets = 0;
-  int64_t bytes = 0;   // payload all-reduced (each rank's buffer size)
-  double seconds = 0;  // wall time from flattening to the unflattened averaged gradients
+  int64_t overlapped_buckets = 0;  // of those, started inside the backward pass
+  int64_t bytes = 0;               // payload all-reduced (each rank's buffer size)
+  // Wall time the all-reduces added to the steps: flattening and starting buckets (inside the
+  // backward pass too), then waiting for them and copying the averages back. Time that Gloo's
+  // threads spent sending while backward went on is not counted: that is the overlap.
+  double seconds = 0;
 };
 
 class Distributed {
@@ -76,8 +81,15 @@ class Distributed {
 
   // In place, from rank 0 (flattened buckets).
   void broadcast(const std::vector<at::Tensor>& tensors);
-  // Each defined gradient of `params` (deduplicated by identity) becomes the mean over the ranks.
-  void average_gradients(const std::vector<at::Tensor>& params);
+  // loss.backward() (when it requires grad); then each defined gradient of `params` (deduplicated
+  // by identity) becomes the mean over the ranks, a parameter without one keeps none. The
+  // all-reduces overlap the backward pass, as PyTorch's DDP reducer does it: a post-hook on each
+  // parameter's gradient accumulator (kept alive, so the hook serves every step) counts the
+  // gradients as they become final, and a bucket's all-reduce starts as soon as its last
+  // gradient is in. Buckets hold the parameters that the loss's graph reaches, last parameter
+  // first (roughly the order in which backward finishes them), and start strictly in bucket
+  // order, so every rank issues the same collectives in the same order.
+  void backward_and_average(const at::Tensor& loss, const std::vector<at::Tensor>& params);
   // In place: the element-wise sum over the ranks (small tensors: losses, flags, norms).
   void sum(at::Tensor& tensor);
   void barrier();
@@ -86,11 +98,13 @@ class Distributed {
 
  private:
   struct Impl;
+  struct Overlap;  // backward_and_average's hooks and this step's buckets
   // Rethrows what a c10d call threw as neraf::Error naming the operation and the timeout.
   [[noreturn]] void fail(const std::string& operation, const std::exception& e) const;
 
   DistributedConfig config_;
   std::unique_ptr<Impl> impl_;
+  std::unique_ptr<Overlap> overlap_;
   CommStats stats_;
 };
 

@@ -229,11 +229,12 @@ StepResult Trainer::step() {
                             "' is " + (std::isnan(result.losses[k]) ? "NaN" : "infinite") +
                             " (training diverged)");
     }
-    if (total.requires_grad()) total.backward();
     if (dist_) {
       std::vector<torch::Tensor> params;
       for (const auto& g : groups_) params.insert(params.end(), g.params.begin(), g.params.end());
-      dist_->average_gradients(params);
+      dist_->backward_and_average(total, params);
+    } else if (total.requires_grad()) {
+      total.backward();
     }
     for (auto& g : groups_) g.optimizer->step();
     if (dist_) {
