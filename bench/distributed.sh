@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Data-parallel training (train/distributed.h, issue 14 §3): 1 → 2 processes with 1 thread each,
 # the same global batch, on this machine: steps/s, speed-up and scaling efficiency (speed-up / 2)
-# for the cpu preset's joint and vision-only training, and the gradient all-reduce per step (bytes, wall time
-# from flattening to averaged gradients, which includes waiting for the slower rank) for the
-# cpu and paper presets.
+# for the cpu preset's joint and vision-only training, and the gradient all-reduce per step (bytes;
+# the wall time it adds to a step: flattening and starting buckets, inside the backward pass too,
+# then waiting for them, which includes waiting for the slower rank; the buckets started during
+# the backward pass) for the cpu and paper presets.
 #   bench/distributed.sh [OUT_JSON]      default build/bench/distributed.json
 #   STEPS=30 REPS=3 PAPER_STEPS=3 bench/distributed.sh
 # Run it alone on the machine (flock /tmp/neraf-build.lock on the shared one); the load before
@@ -33,6 +34,10 @@ a = re.search(r"all-reduce ([\d.]+) MB/step, ([\d.]+) ms/step", line)
 if a:
     out["allreduce_mb_per_step"] = float(a.group(1))
     out["allreduce_ms_per_step"] = float(a.group(2))
+b = re.search(r"\((\d+)/(\d+) buckets started during backward\)", line)
+if b:
+    out["buckets_started_during_backward"] = int(b.group(1))
+    out["buckets"] = int(b.group(2))
 print(out.__repr__().replace("'", '"'))
 EOF
 }

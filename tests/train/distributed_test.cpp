@@ -118,7 +118,7 @@ TEST(Distributed, ShardedSpectralConvergenceEqualsTheWholeBatch) {
 // The all-reduce that overlaps the backward pass, against the mean of the ranks' gradients from a
 // plain backward: parameters reached several times, one in two optimizer groups (listed twice),
 // one the graph does not reach (keeps no gradient), one frozen, many small buckets, two steps
-// (the hooks serve every graph).
+// (the hooks serve every graph); and the same with the overlap off.
 TEST(Distributed, GradientsAreAveragedWhileBackwardRuns) {
   struct Model {
     torch::Tensor a, b, d, unused, frozen;
@@ -156,54 +156,59 @@ TEST(Distributed, GradientsAreAveragedWhileBackwardRuns) {
     for (auto& t : sum) want[static_cast<size_t>(s)].push_back(t / W);
   }
 
-  const int port = free_port();
-  std::vector<std::vector<std::vector<torch::Tensor>>> got(W);
-  std::vector<CommStats> stats(W);
-  std::vector<std::string> errors(W);
-  auto rank_main = [&](int rank) {
-    try {
-      DistributedConfig dc;
-      dc.world_size = W;
-      dc.rank = rank;
-      dc.master_port = port;
-      dc.timeout_s = 30;
-      dc.bucket_bytes = 4000;  // a, d: one bucket each; b (8000 bytes): its own
-      Distributed dist(dc);
-      Model m(7);
-      for (int s = 0; s < steps; ++s) {
-        for (auto& p : m.params()) p.mutable_grad() = torch::Tensor();
-        dist.backward_and_average(m.loss(rank, s), m.params());
-        EXPECT_FALSE(m.unused.grad().defined());
-        EXPECT_FALSE(m.frozen.grad().defined());
-        got[rank].push_back({m.a.grad().clone(), m.b.grad().clone(), m.d.grad().clone()});
+  for (const bool overlap : {true, false}) {
+    SCOPED_TRACE(overlap ? "--dist-overlap on" : "--dist-overlap off");
+    const int port = free_port();
+    std::vector<std::vector<std::vector<torch::Tensor>>> got(W);
+    std::vector<CommStats> stats(W);
+    std::vector<std::string> errors(W);
+    auto rank_main = [&](int rank) {
+      try {
+        DistributedConfig dc;
+        dc.world_size = W;
+        dc.rank = rank;
+        dc.master_port = port;
+        dc.timeout_s = 30;
+        dc.bucket_bytes = 4000;  // a, d: one bucket each; b (8000 bytes): its own
+        dc.overlap_backward = overlap;
+        Distributed dist(dc);
+        Model m(7);
+        for (int s = 0; s < steps; ++s) {
+          for (auto& p : m.params()) p.mutable_grad() = torch::Tensor();
+          dist.backward_and_average(m.loss(rank, s), m.params());
+          EXPECT_FALSE(m.unused.grad().defined());
+          EXPECT_FALSE(m.frozen.grad().defined());
+          got[rank].push_back({m.a.grad().clone(), m.b.grad().clone(), m.d.grad().clone()});
+        }
+        stats[rank] = dist.stats();
+        dist.barrier();
+      } catch (const std::exception& e) {
+        errors[rank] = e.what();
       }
-      stats[rank] = dist.stats();
-      dist.barrier();
-    } catch (const std::exception& e) {
-      errors[rank] = e.what();
+    };
+    std::thread t0(rank_main, 0), t1(rank_main, 1);
+    t0.join();
+    t1.join();
+    for (int r = 0; r < W; ++r) {
+      ASSERT_EQ(errors[r], "") << "rank " << r;
+      ASSERT_EQ(got[r].size(), static_cast<size_t>(steps));
+      for (int s = 0; s < steps; ++s)
+        for (size_t i = 0; i < 3; ++i) {
+          const auto& g = got[r][s][i];
+          const auto& w = want[s][i];
+          EXPECT_LE((g - w).abs().max().item<double>(), 1e-6 * w.abs().max().item<double>())
+              << "rank " << r << " step " << s << " parameter " << i;
+        }
+      EXPECT_EQ(stats[r].allreduces, steps);
+      EXPECT_EQ(stats[r].buckets, 3 * steps);
+      // Overlapped, every bucket's gradients were final before backward returned, so each
+      // started inside it; not overlapped, none did.
+      EXPECT_EQ(stats[r].overlapped_buckets, overlap ? stats[r].buckets : 0);
+      EXPECT_EQ(stats[r].bytes, steps * (300 + 2000 + 100) * 4);
     }
-  };
-  std::thread t0(rank_main, 0), t1(rank_main, 1);
-  t0.join();
-  t1.join();
-  for (int r = 0; r < W; ++r) {
-    ASSERT_EQ(errors[r], "") << "rank " << r;
-    ASSERT_EQ(got[r].size(), static_cast<size_t>(steps));
     for (int s = 0; s < steps; ++s)
-      for (size_t i = 0; i < 3; ++i) {
-        const auto& g = got[r][s][i];
-        const auto& w = want[s][i];
-        EXPECT_LE((g - w).abs().max().item<double>(), 1e-6 * w.abs().max().item<double>())
-            << "rank " << r << " step " << s << " parameter " << i;
-      }
-    EXPECT_EQ(stats[r].allreduces, steps);
-    EXPECT_EQ(stats[r].buckets, 3 * steps);
-    // Every bucket's gradients were final before backward returned, so each started inside it.
-    EXPECT_EQ(stats[r].overlapped_buckets, stats[r].buckets);
-    EXPECT_EQ(stats[r].bytes, steps * (300 + 2000 + 100) * 4);
+      for (size_t i = 0; i < 3; ++i) EXPECT_TRUE(got[0][s][i].equal(got[1][s][i]));
   }
-  for (int s = 0; s < steps; ++s)
-    for (size_t i = 0; i < 3; ++i) EXPECT_TRUE(got[0][s][i].equal(got[1][s][i]));
 }
 
 // Every distinct parameter of the trainer's branches, cloned.

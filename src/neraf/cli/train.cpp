@@ -64,6 +64,7 @@ struct TrainArgs {
   std::string master = "127.0.0.1:29500";
   double dist_timeout = 60;
   std::string dist_interface;
+  std::string dist_overlap = "on";
 };
 
 // The flag's own bound; the memory check below is the one that usually applies.
@@ -283,12 +284,19 @@ void register_train(CLI::App& app) {
       cmd->add_option("--dist-interface", args->dist_interface,
                       "With --world-size: the network interface for the ranks' traffic (e.g. "
                       "eth0; default: the address this host's name resolves to)");
+  CLI::Option* dist_overlap =
+      cmd->add_option("--dist-overlap", args->dist_overlap,
+                      "With --world-size: on starts each gradient bucket's all-reduce inside the "
+                      "backward pass as soon as its gradients are final; off starts them all "
+                      "after it (the same result; for measuring the overlap)")
+          ->check(CLI::IsMember({"on", "off"}))
+          ->capture_default_str();
 
   cmd->callback([args, data, preset, steps, seed, threads, rays, precision, grid, grid_features,
                  fraction, vision_run, audio_start, decay_loss, no_relative, save_every, world_size,
-                 rank, master, dist_timeout, dist_interface]() {
+                 rank, master, dist_timeout, dist_interface, dist_overlap]() {
     if (args->world_size == 1)
-      for (CLI::Option* o : {rank, master, dist_timeout, dist_interface})
+      for (CLI::Option* o : {rank, master, dist_timeout, dist_interface, dist_overlap})
         require(o->count() == 0, o->get_name() + ": only with --world-size N (N > 1)");
     require(args->rank < args->world_size, "--rank " + std::to_string(args->rank) +
                                                ": must be below --world-size " +
@@ -300,6 +308,7 @@ void register_train(CLI::App& app) {
     dist.timeout_s = args->dist_timeout;
     dist.setup_timeout_s = std::max(dist.setup_timeout_s, args->dist_timeout);
     dist.interface = args->dist_interface;
+    dist.overlap_backward = args->dist_overlap == "on";
     if (args->world_size > 1) train::parse_master(args->master, "--master", dist);
     require(!(args->resume && args->force), "--resume and --force: choose one");
     require(args->resume || data->count() > 0, "--data: required (the dataset folder)");
@@ -408,9 +417,13 @@ void register_train(CLI::App& app) {
       if (cfg.modality != infer::Modality::vision)
         std::printf("; audio log-mag MSE %.4f", s.last_audio_sl);
       if (s.comm.allreduces > 0)
-        std::printf("; all-reduce %.1f MB/step, %.1f ms/step",
-                    double(s.comm.bytes) / double(s.comm.allreduces) / 1e6,
-                    1e3 * s.comm.seconds / double(s.comm.allreduces));
+        std::printf(
+            "; all-reduce %.1f MB/step, %.1f ms/step added (%lld/%lld buckets started "
+            "during backward)",
+            double(s.comm.bytes) / double(s.comm.allreduces) / 1e6,
+            1e3 * s.comm.seconds / double(s.comm.allreduces),
+            static_cast<long long>(s.comm.overlapped_buckets),
+            static_cast<long long>(s.comm.buckets));
       std::printf("; checkpoint %s\n", s.checkpoint.c_str());
     }
     if (s.interrupted)

@@ -445,7 +445,7 @@ void Distributed::backward_and_average(const at::Tensor& loss,
   double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
 
   if (loss.requires_grad()) {
-    o.active = true;
+    o.active = config_.overlap_backward;
     try {
       loss.backward();
     } catch (...) {

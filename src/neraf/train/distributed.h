@@ -34,6 +34,9 @@ struct DistributedConfig {
   // or loopback when the master is on this machine.
   std::string interface;
   int64_t bucket_bytes = 25 << 20;  // gradient bucket size (PyTorch DDP's default)
+  // Start each bucket's all-reduce inside the backward pass (backward_and_average); false: all
+  // of them after it (the same result; --dist-overlap off, to measure what the overlap gains).
+  bool overlap_backward = true;
   bool enabled() const { return world_size > 1; }
 };
 
