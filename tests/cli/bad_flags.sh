@@ -110,6 +110,7 @@ bad --rank "$NERAF" train --data "$FIX" --out "$WORK/run" --world-size 2 --rank 
 bad --rank "$NERAF" train --data "$FIX" --out "$WORK/run" --world-size 2 --rank 5
 bad --dist-timeout "$NERAF" train --data "$FIX" --out "$WORK/run" --world-size 2 --dist-timeout nan
 bad --master "$NERAF" train --data "$FIX" --out "$WORK/run" --world-size 2 --master host:99999
+bad --dist-overlap "$NERAF" train --data "$FIX" --out "$WORK/run" --world-size 2 --dist-overlap maybe
 bad --nproc "$NERAF" launch -n 0 -- train --data "$FIX" --out "$WORK/run"
 bad --nproc "$NERAF" launch -n 1000 -- train --data "$FIX" --out "$WORK/run"
 bad --master-port "$NERAF" launch -n 2 --master-port 70000 -- train --data "$FIX" --out "$WORK/run"

@@ -64,7 +64,7 @@ struct TrainArgs {
   std::string master = "127.0.0.1:29500";
   double dist_timeout = 60;
   std::string dist_interface;
-  std::string dist_overlap = "on";
+  std::string dist_overlap = "auto";
 };
 
 // The flag's own bound; the memory check below is the one that usually applies.
@@ -288,8 +288,9 @@ void register_train(CLI::App& app) {
       cmd->add_option("--dist-overlap", args->dist_overlap,
                       "With --world-size: on starts each gradient bucket's all-reduce inside the "
                       "backward pass as soon as its gradients are final; off starts them all "
-                      "after it (the same result; for measuring the overlap)")
-          ->check(CLI::IsMember({"on", "off"}))
+                      "after it (the same result); auto: on unless --master is a loopback "
+                      "address (ranks that share one machine's cores ran slower with it)")
+          ->check(CLI::IsMember({"auto", "on", "off"}))
           ->capture_default_str();
 
   cmd->callback([args, data, preset, steps, seed, threads, rays, precision, grid, grid_features,
@@ -308,8 +309,10 @@ void register_train(CLI::App& app) {
     dist.timeout_s = args->dist_timeout;
     dist.setup_timeout_s = std::max(dist.setup_timeout_s, args->dist_timeout);
     dist.interface = args->dist_interface;
-    dist.overlap_backward = args->dist_overlap == "on";
     if (args->world_size > 1) train::parse_master(args->master, "--master", dist);
+    dist.overlap_backward =
+        args->dist_overlap == "on" ||
+        (args->dist_overlap == "auto" && !train::is_loopback_host(dist.master_host));
     require(!(args->resume && args->force), "--resume and --force: choose one");
     require(args->resume || data->count() > 0, "--data: required (the dataset folder)");
     // The flags as given (unset: the preset's value for the modality), resolved in one place.

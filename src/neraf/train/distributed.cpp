@@ -39,10 +39,6 @@ std::string first_line(const std::exception& e) {
   return what;
 }
 
-bool is_loopback(const std::string& host) {
-  return host == "localhost" || host.rfind("127.", 0) == 0 || host == "::1";
-}
-
 std::string seconds_text(double s) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", s);
@@ -50,6 +46,10 @@ std::string seconds_text(double s) {
 }
 
 }  // namespace
+
+bool is_loopback_host(const std::string& host) {
+  return host == "localhost" || host.rfind("127.", 0) == 0 || host == "::1";
+}
 
 void parse_master(const std::string& text, const std::string& flag, DistributedConfig& out) {
   const size_t colon = text.rfind(':');
@@ -278,7 +278,7 @@ Distributed::Distributed(const DistributedConfig& config)
     if (!config_.interface.empty())
       options->devices.push_back(
           c10d::ProcessGroupGloo::createDeviceForInterface(config_.interface));
-    else if (is_loopback(config_.master_host))
+    else if (is_loopback_host(config_.master_host))
       options->devices.push_back(c10d::ProcessGroupGloo::createDeviceForHostname("127.0.0.1"));
     else
       options->devices.push_back(c10d::ProcessGroupGloo::createDefaultDevice());

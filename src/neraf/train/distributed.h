@@ -35,10 +35,15 @@ struct DistributedConfig {
   std::string interface;
   int64_t bucket_bytes = 25 << 20;  // gradient bucket size (PyTorch DDP's default)
   // Start each bucket's all-reduce inside the backward pass (backward_and_average); false: all
-  // of them after it (the same result; --dist-overlap off, to measure what the overlap gains).
+  // of them after it, with the same result (--dist-overlap; the CLI's default is on unless the
+  // master is a loopback address: ranks that share one machine's cores lost steps/s to it,
+  // docs/BENCHMARKS.md).
   bool overlap_backward = true;
   bool enabled() const { return world_size > 1; }
 };
+
+// Whether `host` names this machine's loopback (localhost, 127.x.y.z, ::1).
+bool is_loopback_host(const std::string& host);
 
 // "HOST:PORT" → host and port; neraf::Error naming `flag` otherwise.
 void parse_master(const std::string& text, const std::string& flag, DistributedConfig& out);
