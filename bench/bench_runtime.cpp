@@ -83,8 +83,6 @@ const Loaded& loaded(bool paper, bool bf16) {
     }
     neraf_model_get_info(l.model, &l.info);
     fs::remove_all(dir);
-    if (bf16 && std::string(neraf_model_compute(l.model)) != "bfloat16-amx")
-      std::fprintf(stderr, "note: no AMX-BF16 here, the bf16 models run in float32\n");
   }
   return l;
 }
@@ -107,6 +105,7 @@ void BM_LogStft(benchmark::State& state) {
       state.SkipWithError(neraf_last_error());
     benchmark::DoNotOptimize(out.data());
   }
+  state.SetLabel(neraf_model_compute(l.model));  // float32, bfloat16-amx or bfloat16-avx512
   neraf_workspace_free(ws);
 }
 BENCHMARK(BM_LogStft)
@@ -128,6 +127,7 @@ void BM_Rir(benchmark::State& state) {
       state.SkipWithError(neraf_last_error());
     benchmark::DoNotOptimize(out.data());
   }
+  state.SetLabel(neraf_model_compute(l.model));  // float32, bfloat16-amx or bfloat16-avx512
   neraf_workspace_free(ws);
 }
 BENCHMARK(BM_Rir)

@@ -5,6 +5,7 @@
 # the demo room (SoundSpaces layout) through --run and --model.
 #   bench/runtime_bench.sh            raw outputs in build/bench-runtime/, summary in
 #                                     bench/results/runtime.json
+#   RESULT=bench/results/x.json ...   the summary there instead
 # Needs a built tree (scripts/build.sh). Takes about 10 minutes on 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,6 +13,7 @@ B=build
 OUT=$B/bench-runtime
 mkdir -p "$OUT"
 reps=(--benchmark_repetitions=5 --benchmark_report_aggregates_only=true)
+RESULT=${RESULT:-bench/results/runtime.json}
 load_before=$(cut -d' ' -f1-3 /proc/loadavg)
 
 # neraf_rt with OpenBLAS on one thread (the advice of docs/RUNTIME.md); the workspace's own
@@ -40,9 +42,9 @@ for source in run model; do
 done
 load_after=$(cut -d' ' -f1-3 /proc/loadavg)
 
-python3 - "$OUT" "$load_before" "$load_after" <<'PY'
+python3 - "$OUT" "$load_before" "$load_after" "$RESULT" <<'PY'
 import json, os, platform, statistics, subprocess, sys, datetime
-out, load_before, load_after = sys.argv[1:]
+out, load_before, load_after, result = sys.argv[1:]
 def medians(path):
     j = json.load(open(path))
     return {b["run_name"]: b["real_time"] if "real_time" in b else b["cpu_time"]
@@ -54,6 +56,8 @@ def counters(path, name):
 rt, ctx = medians(f"{out}/runtime.json")
 lt, _ = medians(f"{out}/libtorch.json")
 units = {b["run_name"]: b["time_unit"] for b in json.load(open(f"{out}/runtime.json"))["benchmarks"]}
+compute = {b["run_name"]: b["label"] for b in json.load(open(f"{out}/runtime.json"))["benchmarks"]
+           if b.get("label")}
 evals = {}
 for source in ("run", "model"):
     reps = [json.load(open(f"{out}/eval_{source}_{r}.json"))["audio"]["novel"] for r in (1, 2, 3)]
@@ -71,7 +75,8 @@ summary = {
     "machine": f"{cpu}, {os.cpu_count()} cores",
     "load_avg_before": load_before, "load_avg_after": load_after,
     "note": "idle machine; neraf_rt with OMP_NUM_THREADS=1; times are medians of 5 repetitions",
-    "runtime_median": {k: {"time": v, "unit": units.get(k, "")} for k, v in rt.items()},
+    "runtime_median": {k: {"time": v, "unit": units.get(k, ""), **({"compute": compute[k]} if k in compute else {})}
+                       for k, v in rt.items()},
     "libtorch_median_ms": lt,
     "eval": evals,
     "model_file_bytes_cpu_preset_run": sizes,
@@ -79,6 +84,6 @@ summary = {
                                 for p, i in (("cpu", 0), ("paper", 1))},
     "export_check": {p: open(f"{out}/export_{p}.txt").read().strip() for p in ("fp32", "bf16")},
 }
-json.dump(summary, open("bench/results/runtime.json", "w"), indent=2)
+json.dump(summary, open(result, "w"), indent=2)
 print(json.dumps(summary, indent=2))
 PY

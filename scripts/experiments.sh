@@ -38,7 +38,6 @@ if ! /usr/bin/python3 -c 'import matplotlib' 2>/dev/null; then  # plots only; no
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends python3-matplotlib
 fi
 scripts/build.sh --target neraf
-NERAF=$PWD/build/neraf
 EXPERIMENTS=${EXPERIMENTS:-"1 2 3 4 5"}
 
 if [ "$QUICK" = 1 ]; then
@@ -68,6 +67,10 @@ else
 fi
 mkdir -p "$OUT"
 LOG=$OUT/experiments.log
+# The runs use a copy of the binary: rebuilding build/neraf while they run would otherwise make a
+# run that starts during the link fail.
+NERAF=$PWD/$OUT/neraf
+cp build/neraf "$NERAF.tmp" && mv "$NERAF.tmp" "$NERAF"
 echo "experiments: $(date -u +%FT%TZ) on $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)," \
   "experiments: $EXPERIMENTS, seeds: ${SEEDS[*]}, quick=$QUICK" | tee -a "$LOG"
 START=$SECONDS

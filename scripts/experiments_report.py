@@ -131,7 +131,7 @@ class Report:
             self.w(f"| {other} | " + " | ".join(cells) + " |")
         self.w()
 
-    def bar_chart(self, groups, series, values, errors, ylabel, title, name):
+    def bar_chart(self, groups, series, values, errors, xlabel, ylabel, title, name):
         """groups on x, one bar per series in each group; values[s][g], errors[s][g]."""
         fig, ax = self.plt.subplots(figsize=(1.2 + 1.3 * len(groups), 3.2))
         width = 0.8 / max(1, len(series))
@@ -142,6 +142,7 @@ class Report:
             ax.bar(xs, ys, width, yerr=es, capsize=3, label=s)
         ax.set_xticks(range(len(groups)))
         ax.set_xticklabels(groups)
+        ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
         ax.set_title(title)
         ax.legend(fontsize=8)
@@ -339,7 +340,8 @@ class Report:
         for metric, label in (("psnr", "PSNR (dB)"), ("ssim", "SSIM")):
             self.bar_chart(views, ["vision", "joint"],
                            {m: plot[m][metric][0] for m in plot}, {m: plot[m][metric][1] for m in plot},
-                           label, f"held-out views by training-view count: {label}",
+                           "training views", label,
+                           f"held-out views by training-view count: {label}",
                            f"e4_{metric}.png")
         self.sample_views(cells)
 

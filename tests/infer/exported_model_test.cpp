@@ -105,7 +105,7 @@ void expect_same_predictions(const std::string& grid, TrainConfig c = tiny_joint
   EXPECT_GT(expected.std().item<double>(), 1e-3);  // not a constant field
 
   // bf16 storage: the weights rounded to 8 mantissa bits; the predictions stay close (the
-  // runtime computes in fp32 unless the CPU has AMX-BF16).
+  // runtime computes in fp32 unless the CPU has AMX-BF16 or AVX512-BF16).
   ExportOptions bf16;
   bf16.bf16 = true;
   const std::string half = dir + "/model_bf16.nrf";

@@ -52,7 +52,8 @@ void register_export(CLI::App& app) {
   cmd->add_option("--out", args->out_path, "model file to write (e.g. room.nrf)")->required();
   cmd->add_option("--precision", args->precision,
                   "weight storage: fp32, or bf16 (about half the size; the runtime computes in "
-                  "bf16 where the CPU has AMX-BF16, else in fp32 with the rounded weights)")
+                  "bf16 where the CPU has AMX-BF16 or AVX512-BF16, else in fp32 with the rounded "
+                  "weights)")
       ->check(CLI::IsMember({"fp32", "bf16"}))
       ->capture_default_str();
   cmd->add_option("--checkpoint", args->checkpoint,

@@ -182,7 +182,7 @@ ExportReport export_model(const AudioRun& run, const std::string& path,
   report.max_abs_difference = (ours - reference).abs().max().item<double>();
   report.poses_checked = check_poses;
   // fp32: float rounding in another summation order (measured ~3e-6); bf16: the rounded weights
-  // (and AMX's bf16 activations where the CPU has them; measured ~1e-2). Far above either means
+  // (and bf16 activations where the CPU computes in bf16; measured ~1e-2). Far above either means
   // the file does not hold this field: it is not left behind.
   const double tolerance = options.bf16 ? 0.25 : 1e-3;
   require(report.max_abs_difference <= tolerance,

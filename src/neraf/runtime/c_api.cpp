@@ -35,8 +35,8 @@ neraf_status guarded(const char* what, Fn&& fn) noexcept {
 
 // The checks both queries share; on success the pose is valid for the model.
 neraf_status check_query(const char* what, const neraf_model* model, neraf_workspace* workspace,
-                         const neraf_pose* pose, unsigned flags, const float* out,
-                         size_t capacity, size_t needed) {
+                         const neraf_pose* pose, unsigned flags, const float* out, size_t capacity,
+                         size_t needed) {
   if (!model || !workspace || !pose || !out)
     return fail(NERAF_ERR_INVALID_ARGUMENT,
                 std::string(what) + ": model, workspace, pose and out must not be NULL");
@@ -44,9 +44,9 @@ neraf_status check_query(const char* what, const neraf_model* model, neraf_works
     return fail(NERAF_ERR_INVALID_ARGUMENT,
                 std::string(what) + ": the workspace was created for another model");
   if (capacity < needed)
-    return fail(NERAF_ERR_BUFFER_TOO_SMALL, std::string(what) + ": out holds " +
-                                                std::to_string(capacity) + " floats, the query "
-                                                "writes " + std::to_string(needed));
+    return fail(NERAF_ERR_BUFFER_TOO_SMALL,
+                std::string(what) + ": out holds " + std::to_string(capacity) +
+                    " floats, the query writes " + std::to_string(needed));
   return neraf::rt::validate_pose(model->info, *pose, flags);
 }
 
@@ -80,8 +80,7 @@ NERAF_RT_API const char* neraf_status_string(neraf_status status) {
   return "unknown status";
 }
 
-NERAF_RT_API neraf_status neraf_model_load_ex(const char* path, unsigned flags,
-                                              neraf_model** out) {
+NERAF_RT_API neraf_status neraf_model_load_ex(const char* path, unsigned flags, neraf_model** out) {
   if (out) *out = nullptr;
   if (!path || !out)
     return fail(NERAF_ERR_INVALID_ARGUMENT, "neraf_model_load: path and out must not be NULL");
@@ -101,7 +100,15 @@ NERAF_RT_API neraf_status neraf_model_load(const char* path, neraf_model** out) 
 
 NERAF_RT_API const char* neraf_model_compute(const neraf_model* model) {
   if (!model) return "";
-  return model->engine.bf16_trunk() ? "bfloat16-amx" : "float32";
+  switch (model->engine.bf16_kernel()) {
+    case neraf::rt::Bf16Kernel::amx:
+      return "bfloat16-amx";
+    case neraf::rt::Bf16Kernel::avx512:
+      return "bfloat16-avx512";
+    case neraf::rt::Bf16Kernel::none:
+      break;
+  }
+  return "float32";
 }
 
 NERAF_RT_API void neraf_model_free(neraf_model* model) { delete model; }
@@ -153,9 +160,9 @@ NERAF_RT_API neraf_status neraf_workspace_set_threads(neraf_workspace* workspace
   });
 }
 
-NERAF_RT_API neraf_status neraf_query_log_stft(const neraf_model* model,
-                                               neraf_workspace* workspace, const neraf_pose* pose,
-                                               unsigned flags, float* out, size_t capacity) {
+NERAF_RT_API neraf_status neraf_query_log_stft(const neraf_model* model, neraf_workspace* workspace,
+                                               const neraf_pose* pose, unsigned flags, float* out,
+                                               size_t capacity) {
   const neraf_status s = check_query("neraf_query_log_stft", model, workspace, pose, flags, out,
                                      capacity, model ? model->engine.log_stft_size() : 0);
   if (s != NERAF_OK) return s;

@@ -69,14 +69,14 @@ Engine::Engine(const ModelData& m, const std::string& name, bool allow_bf16) {
       time_table_[size_t(t) * h1 + h] = static_cast<float>(acc);
     }
   }
-  const bool amx = allow_bf16 && m.bf16_storage && m.trunk.size() > 1 && amx_bf16_available();
-  padded_frames_ = amx ? round_up(n_frames_, kAmxRows) : n_frames_;
+  if (allow_bf16 && m.bf16_storage && m.trunk.size() > 1) bf16_kernel_ = best_bf16_kernel();
+  padded_frames_ = bf16_trunk() ? round_up(n_frames_, kTileRows) : n_frames_;
   for (size_t i = 1; i < m.trunk.size(); ++i) {
     const DenseLayer& d = m.trunk[i];
-    if (amx) {
-      amx_layers_.emplace_back(d.weight.data(), int(d.out), int(d.in));
+    if (bf16_trunk()) {
+      bf16_layers_.emplace_back(d.weight.data(), int(d.out), int(d.in), bf16_kernel_);
       layers_.push_back({int(d.in), int(d.out), {}, d.bias});  // float32 weights not needed
-      max_width_ = std::max(max_width_, amx_layers_.back().out_padded());
+      max_width_ = std::max(max_width_, bf16_layers_.back().out_padded());
     } else {
       layers_.push_back({int(d.in), int(d.out), d.weight, d.bias});
       max_width_ = std::max(max_width_, int(d.out));
@@ -158,7 +158,7 @@ void Engine::query(const neraf_pose& pose, Workspace& ws, float* log, float* wav
   size_t ld = size_t(h1);
   for (size_t i = 0; i < layers_.size(); ++i) {
     const Layer& l = layers_[i];
-    const size_t ld_y = bf16_trunk() ? size_t(amx_layers_[i].out_padded()) : size_t(l.out);
+    const size_t ld_y = bf16_trunk() ? size_t(bf16_layers_[i].out_padded()) : size_t(l.out);
     trunk_layer(i, ws, x, ld, y, ld_y, single_blas);
     for (int t = 0; t < T; ++t) {  // + bias, LeakyReLU
       float* yt = y + size_t(t) * ld_y;
@@ -204,16 +204,18 @@ void Engine::trunk_layer(size_t i, Workspace& ws, const float* x, size_t ld_x, f
   const int T = n_frames_;
   int n = l.out, granule = 16;
   if (bf16_trunk()) {
-    const AmxMatrix& a = amx_layers_[i];
+    const Bf16Matrix& a = bf16_layers_[i];
     pack_activations(x, T, l.in, ld_x, padded_frames_, a.in_padded(), ws.x_tiles_.data());
     n = a.out_padded();
     granule = 32;
   }
   // A helper takes half the columns of layers big enough to repay waking it (AMX computes
-  // ~15× faster, so its layers must be larger).
+  // ~15× faster than float32, AVX512-BF16 ~2×, so their layers must be larger).
   const double macs = double(T) * l.in * l.out;
   const bool split = !ws.helpers_.empty() && n >= 2 * granule &&
-                     (bf16_trunk() ? macs > 3e7 : split_float && macs > 2e6);
+                     (bf16_kernel_ == Bf16Kernel::amx      ? macs > 3e7
+                      : bf16_kernel_ == Bf16Kernel::avx512 ? macs > 4e6
+                                                           : split_float && macs > 2e6);
   const int mid = split ? (n / 2 + granule - 1) / granule * granule : n;
   if (split) {
     ws.layer_part_ = {this, &ws, i, x, ld_x, y, ld_y, mid, n};
@@ -231,8 +233,8 @@ void Engine::trunk_layer(size_t i, Workspace& ws, const float* x, size_t ld_x, f
 void Engine::layer_columns(const LayerPart& p) const {
   if (p.n_begin >= p.n_end) return;
   if (bf16_trunk()) {
-    // y[padded T, columns] = bf16(x)·bf16(W)ᵀ on AMX tiles (x packed by trunk_layer).
-    amx_layers_[p.layer].multiply(p.ws->x_tiles_.data(), padded_frames_, p.y, p.n_begin, p.n_end);
+    // y[padded T, columns] = bf16(x)·bf16(W)ᵀ (x packed by trunk_layer).
+    bf16_layers_[p.layer].multiply(p.ws->x_tiles_.data(), padded_frames_, p.y, p.n_begin, p.n_end);
   } else {
     // y[T, columns] = x[T, in]·W[columns, in]ᵀ.
     const Layer& l = layers_[p.layer];
@@ -278,7 +280,7 @@ Workspace::Workspace(const Engine& engine, int threads) : engine_(engine) {
   act_a_ = alloc_fftw_floats(rows * engine.max_width_);
   act_b_ = alloc_fftw_floats(rows * engine.max_width_);
   size_t max_in = 0;
-  for (const AmxMatrix& a : engine.amx_layers_) max_in = std::max(max_in, size_t(a.in_padded()));
+  for (const Bf16Matrix& a : engine.bf16_layers_) max_in = std::max(max_in, size_t(a.in_padded()));
   x_tiles_.assign(rows * max_in, 0);
   log_stft_.assign(engine.log_stft_size(), 0.0f);
   phases_.assign(size_t(engine.channels_) * engine.n_frames_ * engine.griffin_lim_->phase_stride(),

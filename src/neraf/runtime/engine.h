@@ -12,11 +12,12 @@
 // waveforms, magnitudes clip(e^x − 1e-3, 0, 1e4) into Griffin-Lim (one channel per thread).
 //
 // Precision: float32, except for a model stored in bfloat16 (exported with --precision bf16,
-// trained with a bf16 trunk) on a CPU with AMX-BF16: its trunk layers after the first then run on
-// AMX tiles (amx_gemm.h: activations rounded to bf16 before each layer, float32 accumulation, as
-// the training code's bf16 trunk; ~1e-2 from the float32 result in log-magnitude), unless the
-// caller asks for float32. Layer 1 (time table + pose gemv) and the heads always run in float32,
-// as in training. Elsewhere a bf16 file runs its bf16-rounded weights in float32.
+// trained with a bf16 trunk) on a CPU with AMX-BF16 or AVX512-BF16: its trunk layers after the
+// first then run in bfloat16 (bf16_gemm.h: activations rounded to bf16 before each layer, float32
+// accumulation, as the training code's bf16 trunk; ~1e-2 from the float32 result in
+// log-magnitude), unless the caller asks for float32. Layer 1 (time table + pose gemv) and the
+// heads always run in float32, as in training. Elsewhere a bf16 file runs its bf16-rounded
+// weights in float32.
 // The encodings run in double where the training code's do (positions, rot, relative geometry),
 // the time encoding in float; exp, log and tanh are vectorised approximations (vector_math.h),
 // so float32 results match the torch path to float rounding, not bit for bit.
@@ -36,7 +37,7 @@
 #include <vector>
 
 #include "neraf/neraf_rt.h"
-#include "neraf/runtime/amx_gemm.h"
+#include "neraf/runtime/bf16_gemm.h"
 #include "neraf/runtime/griffin_lim.h"
 #include "neraf/runtime/helper_thread.h"
 #include "neraf/runtime/input_encoding.h"
@@ -49,12 +50,14 @@ class Workspace;
 class Engine {
  public:
   // Validates `m` (check_model_data: throws ModelFileError) and prepares the folded layers, the
-  // time table and the Griffin-Lim plans. allow_bf16: run a bf16 model's trunk on AMX where
-  // available (see above); false: float32 always. Throws std::bad_alloc when out of memory.
+  // time table and the Griffin-Lim plans. allow_bf16: run a bf16 model's trunk in bfloat16 where
+  // the CPU can (see above; best_bf16_kernel); false: float32 always. Throws std::bad_alloc when
+  // out of memory.
   explicit Engine(const ModelData& m, const std::string& name = "model", bool allow_bf16 = true);
 
-  // Whether the trunk runs in bfloat16 on AMX tiles.
-  bool bf16_trunk() const { return !amx_layers_.empty(); }
+  // The kernel of the trunk's bfloat16 products, or none when the trunk runs in float32.
+  Bf16Kernel bf16_kernel() const { return bf16_kernel_; }
+  bool bf16_trunk() const { return bf16_kernel_ != Bf16Kernel::none; }
   int channels() const { return channels_; }
   int n_freq() const { return n_freq_; }
   int n_frames() const { return n_frames_; }
@@ -111,20 +114,21 @@ class Engine {
 
   neraf_model_info info_{};
   int channels_, n_freq_, n_frames_, pose_dim_, first_width_;
-  int max_width_;      // the widest trunk layer (padded to 32 on the AMX path)
-  int padded_frames_;  // T rounded up to AMX's 16 rows (T on the float32 path)
+  int max_width_;      // the widest trunk layer (padded to 32 on the bf16 path)
+  int padded_frames_;  // T rounded up to a tile's 16 rows (T on the float32 path)
+  Bf16Kernel bf16_kernel_ = Bf16Kernel::none;
   int64_t rir_length_;
   float leaky_slope_, output_scale_;
   std::array<double, 3> box_min_, box_max_, extent_m_;
   bool relative_geometry_;
   std::array<float, kNumFrequencies> position_freqs_;
-  std::vector<float> time_table_;  // [T, H1]: W1_time·enc_time(t) + b1
-  std::vector<float> w1_pose_;     // [H1, pose_dim]: trunk[0]'s pose columns
-  std::vector<Layer> layers_;      // trunk[1..] (weights float32; biases used by both paths)
-  std::vector<AmxMatrix> amx_layers_;  // trunk[1..] packed for AMX (bf16 path), else empty
-  std::vector<float> head_weight_;  // [C·F, W]: the heads stacked
-  std::vector<float> head_bias_;    // [C·F]
-  std::vector<float> calibration_;  // [C, F, T] or empty
+  std::vector<float> time_table_;        // [T, H1]: W1_time·enc_time(t) + b1
+  std::vector<float> w1_pose_;           // [H1, pose_dim]: trunk[0]'s pose columns
+  std::vector<Layer> layers_;            // trunk[1..] (weights float32; biases used by both paths)
+  std::vector<Bf16Matrix> bf16_layers_;  // trunk[1..] packed (bf16 path), else empty
+  std::vector<float> head_weight_;       // [C·F, W]: the heads stacked
+  std::vector<float> head_bias_;         // [C·F]
+  std::vector<float> calibration_;       // [C, F, T] or empty
   std::unique_ptr<GriffinLim> griffin_lim_;
 };
 
@@ -147,12 +151,12 @@ class Workspace {
   friend class Engine;
 
   const Engine& engine_;
-  std::vector<float> pose_;      // [pose_dim]
-  std::vector<float> u_;         // [H1]: W1_pose·pose
-  FftwFloats act_a_, act_b_;     // [padded T, max width]: trunk activations (ping-pong)
-  std::vector<uint16_t> x_tiles_;  // the AMX path's bf16 input tiles [padded T, padded width]
-  std::vector<float> log_stft_;  // [C, F, T]: rir()'s log-STFT, then its magnitudes
-  std::vector<float> phases_;    // [C][T][2F]: Griffin-Lim's initial phases for seed_
+  std::vector<float> pose_;            // [pose_dim]
+  std::vector<float> u_;               // [H1]: W1_pose·pose
+  FftwFloats act_a_, act_b_;           // [padded T, max width]: trunk activations (ping-pong)
+  std::vector<uint16_t> x_tiles_;      // the AMX path's bf16 input tiles [padded T, padded width]
+  std::vector<float> log_stft_;        // [C, F, T]: rir()'s log-STFT, then its magnitudes
+  std::vector<float> phases_;          // [C][T][2F]: Griffin-Lim's initial phases for seed_
   std::vector<GriffinLimBuffers> gl_;  // [C]
   std::vector<std::unique_ptr<HelperThread>> helpers_;
   // The helpers' jobs, kept here so that queries allocate nothing.

@@ -395,7 +395,8 @@ void Distributed::backward_and_average(const at::Tensor& loss,
   c10d::ProcessGroupGloo* group = impl_->group.get();
   CommStats* stats = &stats_;
   // Each distinct parameter that takes gradients gets its hook once.
-  std::vector<size_t> order;  // hooked indices, in the order of `params`
+  std::vector<size_t> order;  // hooked indices, in the order of `params`, each once
+  std::vector<bool> listed;   // [hooked]: already in `order`
   for (const at::Tensor& p : params) {
     if (!p.requires_grad()) continue;
     auto [it, added] = o.index.emplace(p.unsafeGetTensorImpl(), o.hooked.size());
@@ -410,8 +411,11 @@ void Distributed::backward_and_average(const at::Tensor& loss,
           }));
       o.hooked.push_back(std::move(h));
     }
-    if (std::find(order.begin(), order.end(), it->second) == order.end())
+    if (listed.size() < o.hooked.size()) listed.resize(o.hooked.size(), false);
+    if (!listed[it->second]) {
+      listed[it->second] = true;
       order.push_back(it->second);
+    }
   }
 
   // This step's buckets: the parameters the graph reaches, last first.
