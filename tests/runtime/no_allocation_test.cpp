@@ -28,12 +28,14 @@ void operator delete(void* p, size_t) noexcept { std::free(p); }
 
 namespace fs = std::filesystem;
 
-TEST(NoAllocation, QueriesAllocateNothing) {
+// A float32 model, and a bf16 one (its trunk in bfloat16 where the CPU has AMX or AVX512-BF16).
+static void expect_queries_allocate_nothing(bool bf16) {
   std::string t = (fs::temp_directory_path() / "neraf_rt_alloc_XXXXXX").string();
   const fs::path dir = ::mkdtemp(t.data());
   const std::string path = (dir / "m.nrf").string();
   neraf::rt::testing::RandomModelOptions o;
   o.relative_geometry = true;
+  o.bf16 = bf16;
   neraf::rt::write_model_file(path, neraf::rt::testing::random_model(o));
   neraf_model* model = nullptr;
   ASSERT_EQ(neraf_model_load(path.c_str(), &model), NERAF_OK);
@@ -54,9 +56,14 @@ TEST(NoAllocation, QueriesAllocateNothing) {
     armed = false;
     EXPECT_EQ(a, NERAF_OK);
     EXPECT_EQ(b, NERAF_OK);
-    EXPECT_EQ(allocations, 0) << threads << " thread(s)";
+    EXPECT_EQ(allocations, 0) << threads << " thread(s), " << neraf_model_compute(model);
   }
   neraf_workspace_free(ws);
   neraf_model_free(model);
   fs::remove_all(dir);
+}
+
+TEST(NoAllocation, QueriesAllocateNothing) {
+  expect_queries_allocate_nothing(false);
+  expect_queries_allocate_nothing(true);
 }
