@@ -29,15 +29,19 @@ OMP_NUM_THREADS=1 "$B/neraf_bench_runtime" "${reps[@]}" \
 # "linear" are scored together (their seconds are the same).
 N=$B/neraf
 "$N" synth --preset demo --layout soundspaces --out "$OUT/scene" --seed 1 --force --quiet
+# The same room heard at 29 new microphone positions (x 4 headings x 4 sources = 464 RIRs, as many
+# as the scene has): neraf eval scores --novel-data, and refuses the run's own dataset there.
+"$N" synth --preset demo --layout soundspaces --mics random --mic-count 29 --seed 2 \
+  --gain-from "$OUT/scene" --out "$OUT/novel" --force --quiet
 "$N" train --data "$OUT/scene" --out "$OUT/run" --steps 40 --audio-start-step 1 --force --quiet
 "$N" export --run "$OUT/run" --out "$OUT/run.nrf" | tee "$OUT/export_fp32.txt"
 "$N" export --run "$OUT/run" --out "$OUT/run_bf16.nrf" --precision bf16 | tee "$OUT/export_bf16.txt"
-# All 464 RIRs of the scene (--novel-data: every RIR of a set of the same room), 3 times each.
+# All 464 RIRs of the new positions, 3 times each.
 for source in run model; do
   if [ $source = run ]; then arg=(--run "$OUT/run"); else arg=(--model "$OUT/run.nrf"); fi
   for rep in 1 2 3; do
     "$N" eval "${arg[@]}" --json "$OUT/eval_${source}_$rep.json" --skip-vision --no-images --quiet \
-      --novel-data "$OUT/scene"
+      --novel-data "$OUT/novel"
   done
 done
 load_after=$(cut -d' ' -f1-3 /proc/loadavg)
