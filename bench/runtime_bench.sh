@@ -59,9 +59,9 @@ def counters(path, name):
             return {k: b[k] for k in ("fp32_file_MB", "bf16_file_MB")}
 rt, ctx = medians(f"{out}/runtime.json")
 lt, _ = medians(f"{out}/libtorch.json")
-units = {b["run_name"]: b["time_unit"] for b in json.load(open(f"{out}/runtime.json"))["benchmarks"]}
-compute = {b["run_name"]: b["label"] for b in json.load(open(f"{out}/runtime.json"))["benchmarks"]
-           if b.get("label")}
+runs = json.load(open(f"{out}/runtime.json"))["benchmarks"]
+units = {b["run_name"]: b["time_unit"] for b in runs}
+compute = {b["run_name"]: b["label"] for b in runs if b.get("label")}  # float32, bfloat16-...
 evals = {}
 for source in ("run", "model"):
     reps = [json.load(open(f"{out}/eval_{source}_{r}.json"))["audio"]["novel"] for r in (1, 2, 3)]

@@ -67,8 +67,7 @@ else
 fi
 mkdir -p "$OUT"
 LOG=$OUT/experiments.log
-# The runs use a copy of the binary: rebuilding build/neraf while they run would otherwise make a
-# run that starts during the link fail.
+# The runs use a copy of the binary: a run started while build/neraf is being relinked would fail.
 NERAF=$PWD/$OUT/neraf
 cp build/neraf "$NERAF.tmp" && mv "$NERAF.tmp" "$NERAF"
 echo "experiments: $(date -u +%FT%TZ) on $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)," \
