@@ -3,6 +3,7 @@
 // of this process, Gloo over 127.0.0.1) against one process with the same global batch.
 #include "neraf/train/distributed.h"
 
+#include <ATen/CPUGeneratorImpl.h>
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
@@ -122,18 +123,20 @@ TEST(Distributed, ShardedSpectralConvergenceEqualsTheWholeBatch) {
 TEST(Distributed, GradientsAreAveragedWhileBackwardRuns) {
   struct Model {
     torch::Tensor a, b, d, unused, frozen;
-    explicit Model(int seed) {
-      torch::manual_seed(seed);
-      a = torch::randn({300}).requires_grad_(true);
-      b = torch::randn({40, 50}).requires_grad_(true);
-      d = torch::randn({100}).requires_grad_(true);
-      unused = torch::randn({64}).requires_grad_(true);
-      frozen = torch::randn({100});
+    // Each draw has its own generator: the ranks' threads run at once, and seeding the global
+    // generator from both made one rank draw the other's numbers (seen on CI).
+    explicit Model(uint64_t seed) {
+      at::Generator gen = at::detail::createCPUGenerator(seed);
+      a = torch::randn({300}, gen).requires_grad_(true);
+      b = torch::randn({40, 50}, gen).requires_grad_(true);
+      d = torch::randn({100}, gen).requires_grad_(true);
+      unused = torch::randn({64}, gen).requires_grad_(true);
+      frozen = torch::randn({100}, gen);
     }
     std::vector<torch::Tensor> params() const { return {a, b, d, b, unused, frozen}; }
     torch::Tensor loss(int rank, int step) const {
-      torch::manual_seed(100 * step + rank);  // this rank's "batch"
-      const torch::Tensor x = torch::randn({300}), y = torch::randn({100});
+      at::Generator gen = at::detail::createCPUGenerator(100 * step + rank);  // this rank's "batch"
+      const torch::Tensor x = torch::randn({300}, gen), y = torch::randn({100}, gen);
       return (a * x).pow(2).sum() + b.sum() * d.sum() + (d * y * frozen).sum() + b.pow(3).mean();
     }
   };
