@@ -28,7 +28,7 @@ THREADS=${THREADS:-1}
 ROOMS=(small_dead demo large_live)
 mkdir -p "$WORK"
 LOAD_BEFORE=$(uptime)
-START=$(date -u +%FT%TZ)
+START=${START:-$(date -u +%FT%TZ)}  # a later call that only gathers the runs passes the runs' start
 log() { echo "[$(date -u +%T)] $*"; }
 
 for r in "${ROOMS[@]}"; do
@@ -46,12 +46,15 @@ for seed in $SEEDS; do
       run=$WORK/s$seed-$r steps=$AUDIO_STEPS
       [ $kind = long ] && run=$WORK/s$seed-$r-long steps=$((3 * AUDIO_STEPS))
       [ -f "$run/eval.json" ] && continue
-      log "single $r seed $seed, $steps steps"
-      "$NERAF" train --modality audio --data "$WORK/$r" --vision-run "$WORK/v-$r" \
-        --steps "$steps" --seed "$seed" --threads "$THREADS" --out "$run" --force --quiet
-      "$NERAF" eval --run "$run" --json "$run/eval.json.tmp" --skip-vision --no-images \
+      if [ ! -f "$run/trained" ]; then
+        log "single $r seed $seed, $steps steps"
+        "$NERAF" train --modality audio --data "$WORK/$r" --vision-run "$WORK/v-$r" \
+          --steps "$steps" --seed "$seed" --threads "$THREADS" --out "$run" --force --quiet
+        touch "$run/trained"
+      fi
+      # neraf writes the JSON atomically: it exists only once the evaluation is complete.
+      "$NERAF" eval --run "$run" --json "$run/eval.json" --skip-vision --no-images \
         --threads "$THREADS" --quiet >"$run.eval.txt"
-      mv "$run/eval.json.tmp" "$run/eval.json"
     done
   done
   for grid in sampled zeros none; do
@@ -65,10 +68,9 @@ for seed in $SEEDS; do
   run=$WORK/m$seed-sampled
   if [ ! -f "$run/eval.json" ]; then
     log "eval multi seed $seed"
-    "$NERAF" eval --run "$run" --json "$run/eval.json.tmp" --skip-vision --no-images \
+    "$NERAF" eval --run "$run" --json "$run/eval.json" --skip-vision --no-images \
       --threads "$THREADS" --ablation-runs "$WORK/m$seed-zeros,$WORK/m$seed-none" --quiet \
       >"$run.eval.txt"
-    mv "$run/eval.json.tmp" "$run/eval.json"
   fi
 done
 
@@ -112,6 +114,7 @@ out = {"command": "bench/multiscene.sh", "date": start, "machine": {"cpu": cpu, 
        "settings": {"seeds": seeds, "audio_steps_single": int(audio_steps),
                     "audio_steps_multi": 3 * int(audio_steps), "vision_steps": int(vision_steps),
                     "threads": int(threads), "preset": "cpu", "rooms": rooms}, "seeds": {}}
+tables = {}  # room → seed → method → per-RIR errors
 for seed in seeds:
     ms = json.load(open(f"{work}/m{seed}-sampled/eval.json"))["audio"]
     entry = {"rooms": {}, "multi_mean": ms["mean"]}
@@ -124,6 +127,10 @@ for seed in seeds:
         multi = per_rir(mcsv, "neraf")
         long = json.load(open(f"{work}/s{seed}-{r}-long/eval.json"))["audio"]
         lcsv = f"{work}/s{seed}-{r}-long/eval/audio_per_rir.csv"
+        tables.setdefault(r, {})[seed] = {
+            "single": per_rir(scsv, "neraf"), "single_long": per_rir(lcsv, "neraf"),
+            "zeros": per_rir(mcsv, "m%s-zeros" % seed), "none": per_rir(mcsv, "m%s-none" % seed),
+            "linear": per_rir(mcsv, "linear"), "multi": multi}
         room = {"single": {k: single[k] for k in ("neraf", "linear", "nearest") if k in single},
                 "single_long": {k: long[k] for k in ("neraf", "linear") if k in long},
                 "paired_multi_minus_single_long": paired(multi, per_rir(lcsv, "neraf")),
@@ -141,6 +148,40 @@ for seed in seeds:
     entry["single_mean"] = single_means
     entry["single_long_mean"] = long_means
     out["seeds"][seed] = entry
+
+# Over the seeds: each comparison's per-RIR difference averaged over the seeds, then its mean and
+# standard error over the RIRs (the paired difference of the seed-averaged models), and the
+# standard error of the per-seed mean differences across the seeds (training randomness).
+def seed_averaged(room_tables, method):
+    keys = set.intersection(*(set(t[method]) for t in room_tables.values()))
+    return {k: {m: sum(t[method][k][m] for t in room_tables.values()) / len(room_tables)
+                for m in METRICS} for k in keys}
+
+def across_seeds(values):
+    n = len(values)
+    mean = sum(values) / n
+    se = math.sqrt(sum((v - mean) ** 2 for v in values) / (n - 1) / n) if n > 1 else None
+    return {"mean": mean, "standard_error_across_seeds": se, "per_seed": values}
+
+COMPARED = ("single", "single_long", "zeros", "none", "linear")
+if len(seeds) >= 2:
+    across = {"rooms": {}, "all_rooms": {}}
+    pooled = {method: {} for method in ("multi",) + COMPARED}
+    for r in rooms:
+        avg = {method: seed_averaged(tables[r], method) for method in ("multi",) + COMPARED}
+        for method, rows in avg.items():
+            pooled[method].update({f"{r}/{k}": v for k, v in rows.items()})
+        entry = {"errors_mean_over_seeds": {method: {m: sum(x[m] for x in rows.values()) / len(rows)
+                                                     for m in METRICS} for method, rows in avg.items()}}
+        for other in COMPARED:
+            entry[f"multi_minus_{other}"] = {
+                "paired_per_rir": paired(avg["multi"], avg[other]),
+                "per_seed": {m: across_seeds([paired(tables[r][s]["multi"], tables[r][s][other])[m]
+                                              ["mean_difference"] for s in seeds]) for m in METRICS}}
+        across["rooms"][r] = entry
+    for other in COMPARED:
+        across["all_rooms"][f"multi_minus_{other}"] = paired(pooled["multi"], pooled[other])
+    out["across_seeds"] = across
 with open(result + ".tmp", "w") as f:
     json.dump(out, f, indent=1)
 os.replace(result + ".tmp", result)
@@ -157,6 +198,14 @@ for seed, e in out["seeds"].items():
                      "paired_multi_minus_zeros", "paired_multi_minus_none"):
             p = x[name]
             print(f"  {r:11s} {name:26s} " + "  ".join(
+                f"{p[m]['mean_difference']:+.4g}±{(p[m]['standard_error'] or float('nan')):.2g}" for m in METRICS))
+if "across_seeds" in out:
+    print(f"over seeds {' '.join(seeds)}: multi - other, per-RIR difference of the seed-averaged errors")
+    for r, x in list(out["across_seeds"]["rooms"].items()) + [("all", out["across_seeds"]["all_rooms"])]:
+        for other in COMPARED:
+            p = x[f"multi_minus_{other}"]
+            p = p.get("paired_per_rir", p)
+            print(f"  {r:11s} vs {other:12s} " + "  ".join(
                 f"{p[m]['mean_difference']:+.4g}±{(p[m]['standard_error'] or float('nan')):.2g}" for m in METRICS))
 print("wrote", result)
 EOF

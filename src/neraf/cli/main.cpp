@@ -36,6 +36,14 @@ const CLI::App* selected_command(const CLI::App& app) {
   }
 }
 
+// "neraf render rir": the command as the user types it.
+std::string command_path(const CLI::App& command) {
+  std::string path;
+  for (const CLI::App* c = &command; c->get_parent(); c = c->get_parent())
+    path = " " + c->get_name() + path;
+  return "neraf" + path;
+}
+
 // Edit distance with adjacent transpositions ("stpes" is one edit from "steps"), for "did you
 // mean" on a mistyped command or option.
 size_t edit_distance(const std::string& a, const std::string& b) {
@@ -160,10 +168,14 @@ int main(int argc, char** argv) {
     std::printf("%s\n", e.what());
     return 0;
   } catch (const CLI::ParseError& e) {
+    // The error, then one line on where the usage is: a whole help page after it would scroll
+    // the error out of sight.
     const CLI::App* command = selected_command(app);
-    std::fprintf(stderr, "error: %s%s\n\n%s", e.what(),
+    const std::string path = command_path(*command);
+    std::fprintf(stderr, "error: %s%s\nUsage: %s%s [OPTIONS]; '%s --help' explains them\n",
+                 e.what(),
                  suggestion(*command, std::vector<std::string>(argv + 1, argv + argc)).c_str(),
-                 command->help().c_str());
+                 path.c_str(), command->get_parent() ? "" : " COMMAND", path.c_str());
     return 2;
   } catch (const neraf::Interrupted& e) {
     std::fprintf(stderr, "interrupted: %s\n", e.what());
