@@ -15,7 +15,9 @@
 #   4. `neraf eval` of every run on each room's held-out split; per-RIR paired differences
 #      (multi − single, sampled − zeros / none) with standard errors from the per-RIR CSVs.
 # Quality only (not timing): run it with THREADS=1 and without the build lock.
-# Usage: bench/multiscene.sh   (env: NERAF, WORK, RESULT, SEEDS, VISION_STEPS, AUDIO_STEPS, THREADS)
+# Usage: bench/multiscene.sh   (env: NERAF, WORK, RESULT, SEEDS, VISION_STEPS, AUDIO_STEPS, THREADS;
+# START, LOAD_BEFORE, LOAD_AFTER: the runs' start and load when a later call only gathers them, e.g. after
+# running one seed per core with SEEDS=1, SEEDS=2, ... into one WORK)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 NERAF=${NERAF:-build/neraf}
@@ -27,8 +29,8 @@ AUDIO_STEPS=${AUDIO_STEPS:-1000}
 THREADS=${THREADS:-1}
 ROOMS=(small_dead demo large_live)
 mkdir -p "$WORK"
-LOAD_BEFORE=$(uptime)
-START=${START:-$(date -u +%FT%TZ)}  # a later call that only gathers the runs passes the runs' start
+LOAD_BEFORE=${LOAD_BEFORE:-$(uptime)}
+START=${START:-$(date -u +%FT%TZ)}
 log() { echo "[$(date -u +%T)] $*"; }
 
 for r in "${ROOMS[@]}"; do
@@ -74,7 +76,7 @@ for seed in $SEEDS; do
   fi
 done
 
-LOAD_AFTER=$(uptime)
+LOAD_AFTER=${LOAD_AFTER:-$(uptime)}
 mkdir -p "$(dirname "$RESULT")"
 python3 - "$WORK" "$RESULT" "$SEEDS" "$AUDIO_STEPS" "$VISION_STEPS" "$THREADS" "$START" \
   "$LOAD_BEFORE" "$LOAD_AFTER" "${ROOMS[@]}" <<'EOF'
@@ -153,7 +155,7 @@ for seed in seeds:
 # standard error over the RIRs (the paired difference of the seed-averaged models), and the
 # standard error of the per-seed mean differences across the seeds (training randomness).
 def seed_averaged(room_tables, method):
-    keys = set.intersection(*(set(t[method]) for t in room_tables.values()))
+    keys = sorted(set.intersection(*(set(t[method]) for t in room_tables.values())))
     return {k: {m: sum(t[method][k][m] for t in room_tables.values()) / len(room_tables)
                 for m in METRICS} for k in keys}
 
