@@ -6,7 +6,8 @@
 #      furnished / empty pair (S = 16 cannot pass the scene encoder, which halves the grid four
 #      times: BatchNorm would see one voxel), and the grid read per query (--grid-features local
 #      and both) beside the published global feature
-#   3. few-shot: 25 / 50 / 75 / 100 % of the training RIRs, baselines given the same RIRs
+#   3. few-shot: 25 / 50 / 75 / 100 % of the training RIRs, baselines given the same RIRs, and
+#      the grid read per query beside the global feature at the fractions below 100 %
 #   4. cross-modal vision: vision-only vs joint with 10 / 20 / 40 training views
 #   5. the loss study: SC+SL-MSE vs SC+SL-L1 vs MSE
 # Every run is repeated over SEEDS; every comparison is paired per RIR (neraf eval) and then
@@ -23,6 +24,8 @@
 #                                     ss_demo raf_furnished)
 #   E2_ROOMS="occluded" scripts/...   experiment 2 on these of its rooms only (default: all three,
 #                                     occluded raf_furnished raf_empty)
+#   E3_FEATURES="0.25" scripts/...    experiment 3's per-query variants at these fractions only
+#                                     (default: 0.25 0.5 0.75; "" for none)
 #   E4_VIEWS="10" scripts/...         experiment 4 with these training-view counts only (default:
 #                                     10 20 40)
 # Runs are kept in build/experiments/ and skipped when their eval JSON exists, so an interrupted
@@ -165,15 +168,34 @@ for e in $EXPERIMENTS; do
       ;;
     3)
       say "3/5 few-shot (25 / 50 / 75 / 100 % of the training RIRs)"
+      for f in ${E3_FEATURES-0.25 0.5 0.75}; do
+        case $f in
+          0.25 | 0.5 | 0.75) ;;
+          *)
+            echo "experiments: E3_FEATURES takes 0.25, 0.5 and 0.75 (100 % is experiment 2's), not '$f'" >&2
+            exit 2
+            ;;
+        esac
+      done
       room raf_furnished --preset furnished_room
       train v_raf_furnished --data "$OUT/data/raf_furnished" --modality vision --seed 1 "${VISION[@]}"
       for s in "${SEEDS[@]}"; do
         for f in 0.25 0.5 0.75 1; do
           run=e3_raf_furnished_f${f}_s$s
           [ "$f" = 1 ] && run=e2_raf_furnished_full_s$s  # the same run as experiment 2's
-          train "$run" --data "$OUT/data/raf_furnished" --modality audio \
-            --vision-run "$OUT/runs/v_raf_furnished" --seed "$s" --audio-fraction "$f" "${AUDIO[@]}"
+          a=(--data "$OUT/data/raf_furnished" --modality audio --vision-run "$OUT/runs/v_raf_furnished"
+            --seed "$s" --audio-fraction "$f" "${AUDIO[@]}")
+          # A scored run is not trained again (its run folder may have been deleted for space).
+          [ -f "$OUT/eval/e3_raf_furnished_f${f}_s$s.json" ] || train "$run" "${a[@]}"
           evaluate "e3_raf_furnished_f${f}_s$s" "$run" --skip-vision
+          # Issue 13 §5: the grid read per query beside the published global feature, at the
+          # fractions E3_FEATURES takes (100 % is experiment 2's furnished-room table).
+          case " ${E3_FEATURES-0.25 0.5 0.75} " in *" $f "*) ;; *) continue ;; esac
+          train "$run" "${a[@]}"
+          train "e3_raf_furnished_features_local_f${f}_s$s" "${a[@]}" --grid-features local
+          train "e3_raf_furnished_features_both_f${f}_s$s" "${a[@]}" --grid-features both
+          evaluate "e3_features_raf_furnished_f${f}_s$s" "$run" --skip-vision --no-baselines \
+            --ablation-runs "$OUT/runs/e3_raf_furnished_features_local_f${f}_s$s,$OUT/runs/e3_raf_furnished_features_both_f${f}_s$s"
         done
       done
       ;;

@@ -306,6 +306,37 @@ class Report:
         axes[0].legend(fontsize=8)
         fig.suptitle("few-shot, furnished room, held-out split: mean over seeds (± SE)", fontsize=10)
         self.image(fig, "e3_few_shot.png", "few-shot curve")
+        features = {f: relabel(self.load(f"e3_features_raf_furnished_f{f}")) for f in fractions}
+        if not any(features.values()):
+            return
+        self.w("### The grid read per query at each fraction (issue 13 §5)")
+        self.w()
+        self.w("The few-shot runs again (the full model: the published global feature) beside the "
+               "same runs with `--grid-features local` and `both`, scored together by `neraf eval "
+               "--ablation-runs`; 100 % is experiment 2's furnished-room table. The full model "
+               "was trained again for this table (its runs had been deleted), so its row can "
+               "differ from the few-shot table above by the builds between them. Held-out split.")
+        self.w()
+        for f in fractions:
+            evals = features[f]
+            if not evals:
+                continue
+            self.w(f"#### {float(f):.0%} of the training RIRs ({len(evals)} seeds)")
+            self.w()
+            labels = [k for a in part_of(evals, "audio") for k in a.get("ablations", {})]
+            labels = list(dict.fromkeys(labels))
+            self.w("| run | " + " | ".join(label for _, label in METRICS) + " |")
+            self.w("|---|" + "---|" * len(METRICS))
+            for name in ["neraf"] + labels:
+                cells = []
+                for metric, _ in METRICS:
+                    xs = [(a["ablations"][name] if name != "neraf" else a["neraf"]).get(metric)
+                          for a in part_of(evals, "audio")
+                          if name == "neraf" or name in a.get("ablations", {})]
+                    cells.append(pm([x for x in xs if x is not None], digits_for(metric)))
+                self.w(f"| {'full (global)' if name == 'neraf' else name} | " + " | ".join(cells) + " |")
+            self.w()
+            self.paired_table(evals, "audio", "paired_ablations")
 
     def experiment4(self):
         views = ["10", "20", "40"]
@@ -435,8 +466,9 @@ def relabel(evals):
 
 
 def short(label):
-    """'e2_occluded_grid_none_s1' -> 'grid none'; 'e5_raf_furnished_loss_mse_s2' -> 'loss mse'."""
-    m = re.match(r"e\d_[a-z]+(?:_(?:furnished|empty|demo))?_(.*)_s\d+$", label)
+    """'e2_occluded_grid_none_s1' -> 'grid none'; 'e5_raf_furnished_loss_mse_s2' -> 'loss mse';
+    'e3_raf_furnished_features_local_f0.25_s1' -> 'features local'."""
+    m = re.match(r"e\d_[a-z]+(?:_(?:furnished|empty|demo))?_(.*?)(?:_f[0-9.]+)?_s\d+$", label)
     return m.group(1).replace("_", " ") if m else label
 
 
