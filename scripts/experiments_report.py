@@ -313,9 +313,10 @@ class Report:
         self.w()
         self.w("The few-shot runs again (the full model: the published global feature) beside the "
                "same runs with `--grid-features local` and `both`, scored together by `neraf eval "
-               "--ablation-runs`; 100 % is experiment 2's furnished-room table. The full model "
-               "was trained again for this table (its runs had been deleted), so its row can "
-               "differ from the few-shot table above by the builds between them. Held-out split.")
+               "--ablation-runs`; 100 % is experiment 2's furnished-room table. Where a few-shot "
+               "run's folder had been deleted, the full model was trained again for this table, "
+               "so its row can differ from the few-shot table above by the builds between "
+               "them. Held-out split.")
         self.w()
         for f in fractions:
             evals = features[f]
