@@ -131,6 +131,22 @@ class Report:
             self.w(f"| {other} | " + " | ".join(cells) + " |")
         self.w()
 
+    def ablation_table(self, evals, part, full_label, baselines=()):
+        """Rows: the full model, its ablation runs (eval --ablation-runs) and `baselines`; then
+        the paired table of the ablations."""
+        labels = list(dict.fromkeys(k for a in part_of(evals, part) for k in a.get("ablations", {})))
+        self.w("| run | " + " | ".join(label for _, label in METRICS) + " |")
+        self.w("|---|" + "---|" * len(METRICS))
+        for name in ["neraf"] + labels + list(baselines):
+            cells = []
+            for metric, _ in METRICS:
+                xs = [(a["ablations"][name] if name in a.get("ablations", {}) else a.get(name, {}))
+                      .get(metric) for a in part_of(evals, part)]
+                cells.append(pm([x for x in xs if x is not None], digits_for(metric)))
+            self.w(f"| {full_label if name == 'neraf' else name} | " + " | ".join(cells) + " |")
+        self.w()
+        self.paired_table(evals, part, "paired_ablations")
+
     def bar_chart(self, groups, series, values, errors, xlabel, ylabel, title, name):
         """groups on x, one bar per series in each group; values[s][g], errors[s][g]."""
         fig, ax = self.plt.subplots(figsize=(1.2 + 1.3 * len(groups), 3.2))
@@ -241,22 +257,7 @@ class Report:
             for part, what in (("audio", "held-out split"), ("novel", "new microphone positions")):
                 self.w(f"### {title}: {what} ({len(evals)} seeds)")
                 self.w()
-                labels = []
-                for a in part_of(evals, part):
-                    for k in a.get("ablations", {}):
-                        if k not in labels:
-                            labels.append(k)
-                self.w("| run | " + " | ".join(label for _, label in METRICS) + " |")
-                self.w("|---|" + "---|" * len(METRICS))
-                for name in ["neraf"] + labels + BASELINES:
-                    cells = []
-                    for metric, _ in METRICS:
-                        xs = [(a["ablations"][name] if name in a.get("ablations", {}) else a.get(name, {}))
-                              .get(metric) for a in part_of(evals, part)]
-                        cells.append(pm([x for x in xs if x is not None], digits_for(metric)))
-                    self.w(f"| {'full (S = 32, global)' if name == 'neraf' else name} | " + " | ".join(cells) + " |")
-                self.w()
-                self.paired_table(evals, part, "paired_ablations")
+                self.ablation_table(evals, part, "full (S = 32, global)", BASELINES)
             self.plot_ablation(evals, room, title)
 
     def plot_ablation(self, evals, room, title):
@@ -324,20 +325,7 @@ class Report:
                 continue
             self.w(f"#### {float(f):.0%} of the training RIRs ({len(evals)} seeds)")
             self.w()
-            labels = [k for a in part_of(evals, "audio") for k in a.get("ablations", {})]
-            labels = list(dict.fromkeys(labels))
-            self.w("| run | " + " | ".join(label for _, label in METRICS) + " |")
-            self.w("|---|" + "---|" * len(METRICS))
-            for name in ["neraf"] + labels:
-                cells = []
-                for metric, _ in METRICS:
-                    xs = [(a["ablations"][name] if name != "neraf" else a["neraf"]).get(metric)
-                          for a in part_of(evals, "audio")
-                          if name == "neraf" or name in a.get("ablations", {})]
-                    cells.append(pm([x for x in xs if x is not None], digits_for(metric)))
-                self.w(f"| {'full (global)' if name == 'neraf' else name} | " + " | ".join(cells) + " |")
-            self.w()
-            self.paired_table(evals, "audio", "paired_ablations")
+            self.ablation_table(evals, "audio", "full (global)")
 
     def experiment4(self):
         views = ["10", "20", "40"]
