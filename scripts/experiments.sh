@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The NeRAF paper's experiments, reproduced on simulated rooms with the cpu preset (issue 13):
 #   1. neraf vs nearest / linear interpolation: a SoundSpaces-layout binaural room and a
-#      RAF-layout mono room with directional sources; held-out split and new microphone positions
+#      RAF-layout mono room with directional sources; held-out split and new microphone positions;
+#      and the grid read per query (--grid-features local and both) beside the global feature
 #   2. the grid ablation (no grid, zero grid, S = 24 / 32 / 64) on the occluded room and on the
 #      furnished / empty pair (S = 16 cannot pass the scene encoder, which halves the grid four
 #      times: BatchNorm would see one voxel), and the grid read per query (--grid-features local
@@ -22,6 +23,8 @@
 #   EXPERIMENTS="1 3" scripts/...     only these experiments (the report covers what exists)
 #   E1_ROOMS="raf_furnished" ...      experiment 1 on these of its rooms only (default: both,
 #                                     ss_demo raf_furnished)
+#   E1_FEATURES=0 scripts/...         experiment 1 without its per-query variants (--grid-features
+#                                     local and both: two more joint runs per room and seed)
 #   E2_ROOMS="occluded" scripts/...   experiment 2 on these of its rooms only (default: all three,
 #                                     occluded raf_furnished raf_empty)
 #   E3_FEATURES="0.25" scripts/...    experiment 3's per-query variants at these fractions only
@@ -130,8 +133,17 @@ for e in $EXPERIMENTS; do
             ;;
         esac
         for s in "${SEEDS[@]}"; do
-          train "e1_${r}_s$s" --data "$OUT/data/$r" --seed "$s" "${JOINT[@]}"
+          a=(--data "$OUT/data/$r" --seed "$s" "${JOINT[@]}")
+          train "e1_${r}_s$s" "${a[@]}"
           evaluate "e1_${r}_s$s" "e1_${r}_s$s" --novel-data "$OUT/data/${r}_novel" --skip-vision
+          # Issue 13 §5: the grid read per query beside the published global feature, trained
+          # jointly like the default run (E1_FEATURES=0 leaves them out).
+          [ "${E1_FEATURES:-1}" = 1 ] || continue
+          train "e1_${r}_features_local_s$s" "${a[@]}" --grid-features local
+          train "e1_${r}_features_both_s$s" "${a[@]}" --grid-features both
+          evaluate "e1_features_${r}_s$s" "e1_${r}_s$s" --novel-data "$OUT/data/${r}_novel" \
+            --skip-vision --no-baselines \
+            --ablation-runs "$OUT/runs/e1_${r}_features_local_s$s,$OUT/runs/e1_${r}_features_both_s$s"
         done
       done
       ;;

@@ -199,6 +199,19 @@ class Report:
                         f"{m} {pm([x for x in v if x is not None])}" for m, v in xs.items()))
                     self.w()
             self.plot_methods(evals, room, title)
+            features = relabel(self.load("e1_features_" + room))
+            if not features:
+                continue
+            self.w(f"### {title}: the grid read per query (issue 13 §5)")
+            self.w()
+            self.w("The default runs above (the published global feature) beside the same joint "
+                   "training with `--grid-features local` and `both`, scored together by `neraf "
+                   "eval --ablation-runs`.")
+            self.w()
+            for part, what in (("audio", "held-out split"), ("novel", "new microphone positions")):
+                self.w(f"#### {what} ({len(features)} seeds)")
+                self.w()
+                self.ablation_table(features, part, "full (global)")
 
     def plot_methods(self, evals, room, title):
         methods = ["neraf", "neraf_uncalibrated", "nearest", "linear"]
