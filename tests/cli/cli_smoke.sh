@@ -12,6 +12,13 @@ for cmd in metrics auralize synth info train eval render; do expect_in "$TMP/out
 expect_exit 0 "$NERAF" --version
 expect_in "$TMP/out" "LibTorch"
 expect_in "$TMP/out" "openblas"
+# libgomp's idle threads spin 1,000 turns, not its 300,000 (two processes on the same cores would
+# hold each other's), unless the user chose how they wait.
+expect_exit 0 env -u GOMP_SPINCOUNT -u OMP_WAIT_POLICY "$NERAF" --version
+expect_in "$TMP/out" "OpenMP wait GOMP_SPINCOUNT=1000"
+expect_exit 0 env -u GOMP_SPINCOUNT OMP_WAIT_POLICY=PASSIVE "$NERAF" --version
+expect_in "$TMP/out" "OpenMP wait OMP_WAIT_POLICY=PASSIVE"
+grep -q GOMP_SPINCOUNT "$TMP/out" && fail "neraf set GOMP_SPINCOUNT beside the user's OMP_WAIT_POLICY"
 expect_exit 2 "$NERAF"
 expect_exit 2 "$NERAF" no-such-command
 expect_exit 2 "$NERAF" metrics --no-such-flag

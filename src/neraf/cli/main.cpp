@@ -121,6 +121,7 @@ std::string address_space_problem() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  neraf::cli::run_again_with_short_openmp_spin(argv);
   // A file-size limit (ulimit -f) then fails the write with EFBIG, which the writers report and
   // clean up after, instead of killing the process mid-write.
   std::signal(SIGXFSZ, SIG_IGN);

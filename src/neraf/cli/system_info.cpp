@@ -2,6 +2,7 @@
 
 #include <sched.h>
 #include <torch/torch.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -12,6 +13,21 @@
 #include "neraf/util/number_text.h"
 
 namespace neraf::cli {
+
+void run_again_with_short_openmp_spin(char** argv) {
+  if (std::getenv("GOMP_SPINCOUNT") || std::getenv("OMP_WAIT_POLICY")) return;
+  if (setenv("GOMP_SPINCOUNT", "1000", 1) != 0) return;
+  execv("/proc/self/exe", argv);
+  unsetenv("GOMP_SPINCOUNT");  // the exec failed: carry on with libgomp's defaults
+}
+
+std::string openmp_wait_text() {
+  std::string out;
+  for (const char* name : {"OMP_WAIT_POLICY", "GOMP_SPINCOUNT"})
+    if (const char* value = std::getenv(name))
+      out += (out.empty() ? "" : ", ") + std::string(name) + "=" + value;
+  return out.empty() ? "libgomp default" : out;
+}
 
 void use_all_cores() {
   cpu_set_t allowed;
@@ -50,8 +66,8 @@ std::string loaded_blas_library() {
 std::string version_text() {
   const std::string blas = loaded_blas_library();
   return std::string("neraf " NERAF_VERSION "\nLibTorch ") + TORCH_VERSION + ", " +
-         std::to_string(torch::get_num_threads()) + " threads\nBLAS " +
-         (blas.empty() ? "(none loaded)" : blas);
+         std::to_string(torch::get_num_threads()) + " threads\nOpenMP wait " + openmp_wait_text() +
+         "\nBLAS " + (blas.empty() ? "(none loaded)" : blas);
 }
 
 }  // namespace neraf::cli
