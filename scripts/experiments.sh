@@ -123,6 +123,13 @@ for e in $EXPERIMENTS; do
   case $e in
     1)
       say "1/5 neraf vs the baselines (default neraf train, joint)"
+      case ${E1_FEATURES:-1} in
+        0 | 1) ;;
+        *)
+          echo "experiments: E1_FEATURES takes 1 (the per-query variants, the default) or 0, not '$E1_FEATURES'" >&2
+          exit 2
+          ;;
+      esac
       for r in ${E1_ROOMS:-ss_demo raf_furnished}; do
         case $r in
           ss_demo) room ss_demo --preset demo --layout soundspaces ;;
