@@ -19,6 +19,18 @@ expect_in "$TMP/out" "OpenMP wait GOMP_SPINCOUNT=1000"
 expect_exit 0 env -u GOMP_SPINCOUNT OMP_WAIT_POLICY=PASSIVE "$NERAF" --version
 expect_in "$TMP/out" "OpenMP wait OMP_WAIT_POLICY=PASSIVE"
 grep -q GOMP_SPINCOUNT "$TMP/out" && fail "neraf set GOMP_SPINCOUNT beside the user's OMP_WAIT_POLICY"
+# Run again under its own name: ps, top and pkill still see the binary's name, not "exe".
+env -u GOMP_SPINCOUNT -u OMP_WAIT_POLICY "$NERAF" synth --preset demo --out "$TMP/comm" --quiet \
+  >/dev/null 2>&1 &
+pid=$!
+for _ in $(seq 300); do  # until the second start (its environment has the setting)
+  tr '\0' '\n' <"/proc/$pid/environ" 2>/dev/null | grep -qx GOMP_SPINCOUNT=1000 && break
+  sleep 0.1
+done
+comm=$(cat "/proc/$pid/comm" 2>/dev/null)
+kill "$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
+[ "$comm" = "$(basename "$NERAF" | cut -c1-15)" ] || fail "neraf runs as '$comm' after its start-up re-run"
 expect_exit 2 "$NERAF"
 expect_exit 2 "$NERAF" no-such-command
 expect_exit 2 "$NERAF" metrics --no-such-flag

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <climits>
 #include <cstdlib>
 #include <fstream>
 #include <string>
@@ -16,9 +17,13 @@ namespace neraf::cli {
 
 void run_again_with_short_openmp_spin(char** argv) {
   if (std::getenv("GOMP_SPINCOUNT") || std::getenv("OMP_WAIT_POLICY")) return;
-  if (setenv("GOMP_SPINCOUNT", "1000", 1) != 0) return;
-  execv("/proc/self/exe", argv);
-  unsetenv("GOMP_SPINCOUNT");  // the exec failed: carry on with libgomp's defaults
+  // The binary's own path: run as /proc/self/exe, ps, top and pkill would call the process "exe".
+  char path[PATH_MAX];
+  const ssize_t n = readlink("/proc/self/exe", path, sizeof(path) - 1);
+  if (n <= 0 || setenv("GOMP_SPINCOUNT", "1000", 1) != 0) return;
+  path[n] = '\0';
+  execv(path, argv);
+  unsetenv("GOMP_SPINCOUNT");  // the exec failed (the binary replaced?): carry on as we are
 }
 
 std::string openmp_wait_text() {
