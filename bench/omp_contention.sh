@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Two neraf trainings at once on one machine: how much each loses when both ask for all cores,
 # and whether OpenMP's wait policy matters. LibTorch and OpenBLAS share libgomp's thread pool,
-# whose idle threads spin before they sleep (OMP_WAIT_POLICY unset); a spinning thread of one
+# whose idle threads spin before they sleep (300,000 turns unless told); a spinning thread of one
 # process holds a core the other process's working thread needs.
 # Cases, each with idle threads spinning 300,000 turns (libgomp's default), 10,000, 1,000 (what
 # neraf sets unless GOMP_SPINCOUNT or OMP_WAIT_POLICY is set) and not at all (PASSIVE)
