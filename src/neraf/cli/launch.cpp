@@ -28,6 +28,7 @@
 
 #include "neraf/cli/commands.h"
 #include "neraf/cli/flag_checks.h"
+#include "neraf/cli/system_info.h"
 #include "neraf/infer/train_config.h"
 #include "neraf/train/interrupt.h"
 #include "neraf/util/error.h"
@@ -86,6 +87,8 @@ pid_t spawn(const std::vector<std::string>& argv, int out_fd) {
   std::vector<char*> cargv;
   for (const auto& a : argv) cargv.push_back(const_cast<char*>(a.c_str()));
   cargv.push_back(nullptr);
+  std::string exe = own_executable();
+  if (exe.empty()) exe = "/proc/self/exe";
   const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   require(pid >= 0, std::string("launch: cannot start a process (") + std::strerror(errno) + ")");
@@ -101,9 +104,8 @@ pid_t spawn(const std::vector<std::string>& argv, int out_fd) {
       ::dup2(out_fd, STDERR_FILENO);
       ::close(out_fd);
     }
-    ::execv("/proc/self/exe", cargv.data());
-    std::fprintf(stderr, "error: launch: cannot run %s (%s)\n", "/proc/self/exe",
-                 std::strerror(errno));
+    ::execv(exe.c_str(), cargv.data());
+    std::fprintf(stderr, "error: launch: cannot run %s (%s)\n", exe.c_str(), std::strerror(errno));
     ::_exit(127);
   }
   return pid;

@@ -15,14 +15,17 @@
 
 namespace neraf::cli {
 
-void run_again_with_short_openmp_spin(char** argv) {
-  if (std::getenv("GOMP_SPINCOUNT") || std::getenv("OMP_WAIT_POLICY")) return;
-  // The binary's own path: run as /proc/self/exe, ps, top and pkill would call the process "exe".
+std::string own_executable() {
   char path[PATH_MAX];
   const ssize_t n = readlink("/proc/self/exe", path, sizeof(path) - 1);
-  if (n <= 0 || setenv("GOMP_SPINCOUNT", "1000", 1) != 0) return;
-  path[n] = '\0';
-  execv(path, argv);
+  return n > 0 ? std::string(path, size_t(n)) : std::string();
+}
+
+void run_again_with_short_openmp_spin(char** argv) {
+  if (std::getenv("GOMP_SPINCOUNT") || std::getenv("OMP_WAIT_POLICY")) return;
+  const std::string exe = own_executable();
+  if (exe.empty() || setenv("GOMP_SPINCOUNT", "1000", 1) != 0) return;
+  execv(exe.c_str(), argv);
   unsetenv("GOMP_SPINCOUNT");  // the exec failed (the binary replaced?): carry on as we are
 }
 

@@ -11,6 +11,10 @@ namespace neraf::cli {
 // OMP_WAIT_POLICY. Returns only when it did not run it again.
 void run_again_with_short_openmp_spin(char** argv);
 
+// The path of this program's binary (/proc/self/exe resolved), "" when it cannot be read. Exec it
+// rather than /proc/self/exe, which would name the new process "exe" in ps, top and pkill.
+std::string own_executable();
+
 // How libgomp's idle threads wait, as the environment sets it ("GOMP_SPINCOUNT=1000", or
 // "libgomp default" when neither variable is set).
 std::string openmp_wait_text();
