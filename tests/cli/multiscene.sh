@@ -30,6 +30,14 @@ expect_file "$M/checkpoints/step-000000005.calibration.pt"
 expect_in "$M/data.json" '"scenes"'
 expect_in "$M/data.json" '"name": "small_dead"'
 expect_in "$M/config.json" '"vision_runs"'
+# Each scene keeps its own frames per RIR (the small room's are fewer) beside the run's common
+# frames, to which its features are padded.
+python3 - "$M/data.json" <<'EOF' || fail "data.json: the scenes' own frames are not recorded"
+import json, sys
+a = [s["audio"] for s in json.load(open(sys.argv[1]))["scenes"]]
+assert a[0]["max_len"] == a[1]["max_len"] == a[0]["scene_frames"], a
+assert 2 <= a[1]["scene_frames"] < a[1]["max_len"], a
+EOF
 
 # --- render and export name a scene; the two scenes differ -------------------------------------
 expect_exit 1 "$NERAF" render rir --run "$M" --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 --yaw 90 \
@@ -48,6 +56,15 @@ expect_exit 1 "$NERAF" render rir --run "$VA" --scene demo --mic 2.0,1.5,2.5 --s
   --yaw 90 --out "$TMP/x.wav"
 expect_exit 0 "$NERAF" eval --model "$TMP/dead.nrf" --json "$TMP/model.json" --max-rirs 2 \
   --no-baselines --quiet
+# The small room renders its own length, through the run and through its export alike.
+expect_exit 0 "$NERAF" render rir --model "$TMP/dead.nrf" --mic 1.5,1.2,1.3 --src 1.0,1.2,1.0 \
+  --yaw 90 --out "$TMP/dead_model.wav" --allow-outside
+expect_exit 0 "$NERAF" render rir --run "$M" --scene demo --mic 2.0,1.5,2.5 --src 1.1,1.2,0.9 \
+  --yaw 90 --out "$TMP/demo_run.wav"
+[ "$(stat -c %s "$TMP/dead_model.wav")" = "$(stat -c %s "$TMP/before.wav")" ] ||
+  fail "the exported small room renders another length than its run"
+[ "$(stat -c %s "$TMP/before.wav")" -lt "$(stat -c %s "$TMP/demo_run.wav")" ] ||
+  fail "the small room is not rendered at its own (shorter) length"
 
 # --- eval: every scene and the mean, with a --grid zeros ablation trained alike -----------------
 expect_exit 0 "$NERAF" train --data "$A" --vision-run "$VA" --data "$B" --vision-run "$VB" \

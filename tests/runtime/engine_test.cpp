@@ -115,8 +115,10 @@ std::vector<double> reference_log_stft(const ModelData& m, const neraf_pose& pos
   const int C = m.channels, F = m.n_freq, T = m.max_len;
   std::vector<double> out(size_t(C) * F * T);
   for (int t = 0; t < T; ++t) {
-    // The time encoding in float (t/(T − 1) in float, as the training code).
-    const float x = float(t) / float(T - 1);
+    // The time encoding in float (t/(T − 1) in float, as the training code; T the frames it
+    // spans, more than those predicted for a scene of a multi-scene run).
+    const int spanned = m.time_frames > 0 ? m.time_frames : T;
+    const float x = float(t) / float(spanned - 1);
     std::vector<double> h = nerf_encoding(std::vector<float>{x}, frequencies(8.0));
     for (double v : pose_in) h.push_back(double(float(v)));
     EXPECT_EQ(int64_t(h.size()), m.input_dim());
@@ -228,6 +230,15 @@ TEST(Engine, MatchesTheReferenceWithRelativeGeometry) {
   o.relative_geometry = true;
   o.position_max_freq_exp = 1.0;  // preset cpu
   o.seed = 2;
+  expect_matches_reference(o);
+}
+
+// A scene of a multi-scene run at its own length: the first 7 of a 12-frame time encoding.
+TEST(Engine, MatchesTheReferenceWithAShorterScene) {
+  RandomModelOptions o;
+  o.max_len = 7;
+  o.time_frames = 12;
+  o.seed = 4;
   expect_matches_reference(o);
 }
 

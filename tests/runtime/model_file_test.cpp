@@ -56,6 +56,7 @@ void expect_same(const ModelData& a, const ModelData& b) {
   EXPECT_EQ(a.hop_length, b.hop_length);
   EXPECT_EQ(a.n_freq, b.n_freq);
   EXPECT_EQ(a.max_len, b.max_len);
+  EXPECT_EQ(a.time_frames, b.time_frames);
   EXPECT_EQ(a.waveform_length, b.waveform_length);
   EXPECT_EQ(a.box_min, b.box_min);
   EXPECT_EQ(a.box_max, b.box_max);
@@ -315,11 +316,28 @@ TEST(ModelFile, ReadErrorsNameTheFile) {
 
 TEST(ModelFile, NewerVersionAsksForAnUpdate) {
   std::vector<uint8_t> bytes = serialize_model(random_model(tiny()));
-  bytes[8] = 2;
+  bytes[8] = 3;
   const ModelFileError e = parse_error(bytes, "future.nrf");
   EXPECT_EQ(e.status(), NERAF_ERR_VERSION);
   EXPECT_STREQ(e.what(),
-               "future.nrf: written by a newer neraf (format 2, this reads up to 1); update neraf");
+               "future.nrf: written by a newer neraf (format 3, this reads up to 2); update neraf");
+}
+
+// Format 2 only where a reader of format 1 would go wrong: a time encoding spanning more frames
+// than the file predicts (a multi-scene run's shorter scene).
+TEST(ModelFile, TimeFramesNeedFormat2) {
+  RandomModelOptions o = tiny();
+  const std::vector<uint8_t> plain = serialize_model(random_model(o));
+  EXPECT_EQ(plain[8], 1);
+  o.time_frames = o.max_len;  // the same as none
+  EXPECT_EQ(serialize_model(random_model(o))[8], 1);
+  o.time_frames = o.max_len + 5;
+  const ModelData m = random_model(o);
+  const std::vector<uint8_t> bytes = serialize_model(m);
+  EXPECT_EQ(bytes[8], 2);
+  expect_same(parse_model(bytes.data(), bytes.size(), "scene.nrf"), m);
+  o.time_frames = o.max_len - 1;  // fewer frames than predicted: refused by the writer
+  EXPECT_THROW(serialize_model(random_model(o)), ModelFileError);
 }
 
 TEST(ModelFile, EveryTruncationIsRejected) {

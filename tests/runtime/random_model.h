@@ -12,7 +12,8 @@ namespace neraf::rt::testing {
 struct RandomModelOptions {
   int channels = 2;
   int n_fft = 64, win_length = 64, hop_length = 16;
-  int max_len = 12;  // T
+  int max_len = 12;     // T
+  int time_frames = 0;  // the time encoding's frames (0: max_len)
   std::vector<int64_t> trunk = {24, 16};
   bool relative_geometry = false;
   bool calibration = true;
@@ -49,6 +50,7 @@ inline ModelData random_model(const RandomModelOptions& o = {}) {
   m.hop_length = o.hop_length;
   m.n_freq = o.n_fft / 2 + 1;
   m.max_len = o.max_len;
+  m.time_frames = o.time_frames;
   m.waveform_length = o.waveform_length;
   m.box_min = {-1.0, 0.0, -2.0};
   m.box_max = {3.0, 2.5, 1.5};
@@ -60,7 +62,8 @@ inline ModelData random_model(const RandomModelOptions& o = {}) {
     m.trunk.push_back(random_layer(in, width, 1.0, gen));
     in = width;
   }
-  for (int c = 0; c < o.channels; ++c) m.heads.push_back(random_layer(in, m.n_freq, o.head_gain, gen));
+  for (int c = 0; c < o.channels; ++c)
+    m.heads.push_back(random_layer(in, m.n_freq, o.head_gain, gen));
   if (o.calibration) {
     std::uniform_real_distribution<float> g(0.5f, 2.0f);
     m.calibration.resize(size_t(o.channels) * m.n_freq * m.max_len);

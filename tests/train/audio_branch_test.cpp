@@ -225,6 +225,59 @@ TEST(AudioBranch, MultiSceneStepsOverBothScenesAndResumesExactly) {
   }
 }
 
+// Multi-scene with the scenes' own frames: the epoch permutation covers each scene's own slices
+// only (a short scene's padding is never drawn); frames equal to max_len draw exactly what the
+// branch without frame counts draws; a checkpoint drawn over other frames is refused.
+TEST(AudioBranch, MultiSceneDrawsEachScenesOwnFrames) {
+  const std::string dir = make_temp_dir("multiframes");
+  const data::RirSet a = tiny_rir_set(dir + "/a");
+  const data::RirSet b = tiny_rir_set(dir + "/b", /*move_a_point=*/true);
+  TrainConfig c = tiny_joint_config();
+  c.modality = infer::Modality::audio;
+  const int64_t T = a.max_len;
+  ASSERT_GT(T, 2);
+  auto make = [&](const std::vector<int64_t>& frames) {
+    torch::manual_seed(0);
+    auto t = std::make_unique<Trainer>(c, torch::kCPU);
+    std::vector<nerf::NerfactoModel> fields;
+    for (uint64_t k = 0; k < 2; ++k) {
+      fields.emplace_back(c.model, 4, 7 + k);
+      for (auto& p : fields.back()->parameters()) p.set_requires_grad(false);
+    }
+    t->add_branch(std::make_unique<AudioBranch>(
+        c, std::vector<const data::RirSet*>{&a, &b}, fields,
+        std::vector<acoustic::WorldToField>(2, acoustic::kIdentityWorldToField),
+        /*frozen_field=*/true, torch::kCPU, frames));
+    return t;
+  };
+  auto saved_perm = [&](Trainer& t, const std::string& path) {
+    t.save_checkpoint(path);
+    torch::serialize::InputArchive archive, branch;
+    infer::load_archive(archive, path);
+    archive.read("branch_audio", branch);
+    torch::Tensor perm;
+    branch.read("perm", perm);
+    return perm;
+  };
+  auto full = make({}), same = make({T, T}), own = make({T, 2});
+  for (int i = 0; i < 2; ++i) {
+    const StepResult x = full->step(), y = same->step(), z = own->step();
+    EXPECT_DOUBLE_EQ(x.losses.at("audio_mag_loss"), y.losses.at("audio_mag_loss"));
+    EXPECT_NE(x.losses.at("audio_mag_loss"), z.losses.at("audio_mag_loss"));  // other slices
+  }
+  const int64_t na = static_cast<int64_t>(a.train.size()),
+                nb = static_cast<int64_t>(b.train.size());
+  const torch::Tensor perm = saved_perm(*own, dir + "/own.pt");
+  EXPECT_EQ(perm.numel(), na * T + nb * 2);
+  EXPECT_EQ(saved_perm(*full, dir + "/full.pt").numel(), (na + nb) * T);
+  try {
+    make({T, 3})->load_checkpoint(dir + "/own.pt");
+    FAIL() << "expected neraf::Error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("(RIR, frame) slices"), std::string::npos) << e.what();
+  }
+}
+
 // Multi-scene with the grid read per query: each scene's positions reach its own grid through
 // its own world map.
 TEST(AudioBranch, MultiScenePerQueryFeaturesUseEachScenesWorldMap) {

@@ -285,7 +285,7 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
   if (args.cache_dir_opt && args.cache_dir_opt->count()) cache.dir = args.cache_dir;
   if (!args.cache_precision.empty()) cache.precision = args.cache_precision;
   // The run's data as training loaded it (same options, same cache file).
-  const data::RirSet rirs = load_rirs(data_dir, !args.quiet, cache, cache.max_len);
+  data::RirSet rirs = load_rirs(data_dir, !args.quiet, cache, cache.max_len);
   infer::check_audio_manifest(source.manifest.at("audio"), rirs, data_dir);
   std::vector<Ablation> ablations;
   std::set<std::string> labels;  // the table's and the JSON's name of each: its folder's name
@@ -311,6 +311,8 @@ nlohmann::json evaluate_audio_json(const EvalField& source, const EvalArgs& args
                                 dir + "/data.json");
     check_trained_alike(*source.run, args.run, ablations.back().run, dir);
   }
+  // A multi-scene run's scene is scored at its own frames (training padded it to the longest's).
+  if (run.info().max_len < rirs.max_len) rirs = data::first_frames(rirs, run.info().max_len);
   eval::AudioEvalOptions opts;
   opts.progress = !args.quiet;
   opts.baselines = !args.no_baselines;

@@ -398,6 +398,16 @@ RirSet load_raf(const std::string& dir, const RirLoadOptions& options) {
   return load(dir, AudioLayout::raf, options);
 }
 
+RirSet first_frames(const RirSet& rirs, int64_t frames) {
+  require(frames >= 2 && frames <= rirs.max_len,
+          rirs.root + ": cannot cut " + std::to_string(rirs.max_len) + "-frame RIRs to " +
+              std::to_string(frames) + " frames");
+  RirSet out = rirs;
+  out.max_len = frames;
+  if (out.layout == AudioLayout::soundspaces) out.waveform_length = frames * out.stft.hop_length;
+  return out;
+}
+
 std::optional<int64_t> published_max_len(const std::string& scene_name) {
   static const std::pair<const char*, int64_t> kPublished[] = {
       {"office_4", 78},    {"room_2", 84},           {"apartment_1", 101},

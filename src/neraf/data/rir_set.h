@@ -123,6 +123,12 @@ struct RirSet {
   std::shared_ptr<const FeatureCache> cache_;  // the cached features (shared by copies)
 };
 
+// The same RIRs with only their first `frames` (2 ≤ frames ≤ rirs.max_len) frames per RIR: the
+// features are read from the same cache, and the SoundSpaces evaluation waveforms are frames·hop
+// samples (RAF's stay 0.32 s). A multi-scene run pads its scenes to the longest; each scene is
+// scored and rendered at its own length through this.
+RirSet first_frames(const RirSet& rirs, int64_t frames);
+
 // SoundSpaces frames per RIR of the scenes the NeRAF paper trains on (office_4 78, room_2 84,
 // apartment_1 101, apartment_2 86, frl_apartment_2 107, frl_apartment_4 103), by the name of the
 // scene's folder; nullopt for any other name.

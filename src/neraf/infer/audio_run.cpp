@@ -157,7 +157,9 @@ std::vector<int64_t> audio_train_subset(const data::RirSet& rirs, double fractio
 
 torch::Tensor AudioRun::predict_pose(const torch::Tensor& mic_m, const torch::Tensor& src_m,
                                      const torch::Tensor& rot) const {
-  const torch::Tensor raw = model_->render_stft_with_feature(features_, mic_m, src_m, rot);
+  // [C, F, T]: a scene of a multi-scene run is cut to its own frames.
+  const torch::Tensor raw =
+      model_->render_stft_with_feature(features_, mic_m, src_m, rot).narrow(2, 0, info_.max_len);
   return calibration_.defined() ? acoustic::apply_calibration(raw, calibration_)
                                 : raw;  // [C, F, T]
 }
@@ -207,11 +209,11 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
   out.info_ = audio_info_from_manifest(out.run_.manifest["audio"], manifest_path);
   out.run_.checkpoint = checkpoint_of_run(run_dir, checkpoint);
   const AudioRunInfo& info = out.info_;
-  acoustic::AcousticModelOptions opts =
-      audio_model_options(out.run_.config, info.channels, info.n_freq, info.max_len, info.aabb,
-                          out.run_.config.audio.grid_features == "global"
-                              ? acoustic::kIdentityWorldToField  // not read
-                              : world_to_field(out.run_.manifest, manifest_path));
+  acoustic::AcousticModelOptions opts = audio_model_options(
+      out.run_.config, info.channels, info.n_freq, info.model_frames(), info.aabb,
+      out.run_.config.audio.grid_features == "global"
+          ? acoustic::kIdentityWorldToField  // not read
+          : world_to_field(out.run_.manifest, manifest_path));
   // Queries run in fp32 unless asked (bf16 training keeps fp32 master weights): the numbers of
   // eval and render then do not depend on the machine, and match an fp32 export.
   opts.nacf.bf16 = precision == nerf::Precision::bf16;

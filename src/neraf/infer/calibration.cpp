@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <optional>
 
 #include "neraf/acoustic/calibration.h"
 #include "neraf/infer/checkpoint.h"
@@ -23,9 +24,14 @@ void stop_if_asked(const std::atomic<bool>* stop) {
 }
 }  // namespace
 
-torch::Tensor fit_calibration(const AudioRun& run, const data::RirSet& rirs,
+torch::Tensor fit_calibration(const AudioRun& run, const data::RirSet& all_frames,
                               const std::atomic<bool>* stop) {
   const TrainConfig& config = run.run().config;
+  // A multi-scene run's scene: fitted on its own frames, as it predicts them.
+  std::optional<data::RirSet> cut;
+  if (run.info().max_len < all_frames.max_len)
+    cut = data::first_frames(all_frames, run.info().max_len);
+  const data::RirSet& rirs = cut ? *cut : all_frames;
   const int64_t C = rirs.channels, F = rirs.n_freq, T = rirs.max_len;
   if (!config.audio.energy_calibration) return torch::ones({C, F, T});
   torch::NoGradGuard no_grad;

@@ -16,7 +16,8 @@
 
 namespace neraf::infer {
 
-// [C, F, T] gains fitted for `run` (loaded uncalibrated) on the run's training RIRs of `rirs`
+// [C, F, T] gains fitted for `run` (loaded uncalibrated) on the run's training RIRs of `rirs` (as
+// training loaded them; a multi-scene run's scene is fitted on its own run.info().max_len frames)
 // (its few-shot subset; at most 512 evenly strided for the energies, 64 of those rendered
 // through Griffin-Lim for the balance); all ones when the run has calibration off. `stop` (set
 // asynchronously by Ctrl-C / SIGTERM) makes it throw neraf::Interrupted between two RIRs.

@@ -77,6 +77,7 @@ rt::ModelData export_model_data(const AudioRun& run, const ExportOptions& option
   m.hop_length = info.stft.hop_length;
   m.n_freq = static_cast<int>(info.n_freq);
   m.max_len = static_cast<int>(info.max_len);
+  m.time_frames = static_cast<int>(info.time_frames);
   m.waveform_length = info.waveform_length;
   m.box_min = {info.aabb.min.x, info.aabb.min.y, info.aabb.min.z};
   m.box_max = {info.aabb.max.x, info.aabb.max.y, info.aabb.max.z};

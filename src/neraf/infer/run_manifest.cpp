@@ -113,6 +113,17 @@ AudioRunInfo audio_info_from_manifest(const nlohmann::json& a, const std::string
           "expected 2..100000 frames");
     check(info.waveform_length >= 1, "waveform_length", a["waveform_length"],
           "expected a positive sample count");
+    if (a.contains("scene_frames")) {
+      // A scene of a multi-scene run: its own frames of the run's (max_len) time range.
+      const int64_t own = integer("scene_frames");
+      check(own >= 2 && own <= info.max_len, "scene_frames", a["scene_frames"],
+            "expected 2..max_len frames");
+      if (own < info.max_len) {
+        info.time_frames = info.max_len;
+        info.max_len = own;
+        if (layout == "soundspaces") info.waveform_length = own * hop_length;
+      }
+    }
     const geometry::Vec3 &lo = info.aabb.min, &hi = info.aabb.max;
     for (double v : {lo.x, lo.y, lo.z, hi.x, hi.y, hi.z})
       check(std::isfinite(v), "aabb_min/aabb_max", a["aabb_min"], "expected finite metres");

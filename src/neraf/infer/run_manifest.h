@@ -40,7 +40,11 @@ struct AudioRunInfo {
   int sample_rate = 22050;  // 22050 SoundSpaces, 48000 RAF
   dsp::StftParams stft;     // soundspaces() / raf()
   int64_t n_freq = 257;
-  int64_t max_len = 78;         // frames per RIR (T)
+  int64_t max_len = 78;  // frames per RIR (T)
+  // The frames the model's time encoding spans when it predicts fewer (a multi-scene run's scene
+  // of its own length: the longest scene's frames); 0 = max_len.
+  int64_t time_frames = 0;
+  int64_t model_frames() const { return time_frames > 0 ? time_frames : max_len; }
   int channels = 2;             // C
   int64_t waveform_length = 0;  // GT eval waveform length (SoundSpaces max_len·hop, RAF 15360)
   data::Aabb aabb;              // train audio aabb (positions are normalised with it)
@@ -49,6 +53,8 @@ struct AudioRunInfo {
 // The "audio" entry of RUN/data.json, checked: neraf::Error naming `where` when a key is missing
 // or of the wrong type ("incomplete") or a value is out of its range ("damaged": sample rate,
 // channels, STFT sizes, n_freq = n_fft/2 + 1, max_len, a box that is finite and not inside out).
+// A scene's audio.scene_frames (multi-scene runs) below max_len becomes max_len, with max_len as
+// time_frames.
 AudioRunInfo audio_info_from_manifest(const nlohmann::json& audio, const std::string& where);
 
 // {"fx","fy","cx","cy","width","height"[,"k1","k2","k3","p1","p2"]} ↔ Intrinsics (checked;

@@ -61,7 +61,7 @@ Engine::Engine(const ModelData& m, const std::string& name, bool allow_bf16) {
   const std::array<float, kNumFrequencies> time_freqs = encoding_frequencies(8.0);
   float enc[kTimeDim];
   for (int t = 0; t < n_frames_; ++t) {
-    encode_time(t, n_frames_, time_freqs, enc);
+    encode_time(t, m.time_frames > 0 ? m.time_frames : n_frames_, time_freqs, enc);
     for (int h = 0; h < h1; ++h) {
       const float* w = l1.weight.data() + size_t(h) * in1;
       double acc = l1.bias[h];

@@ -86,6 +86,7 @@ json header_json(const ModelData& m) {
   h["hop_length"] = m.hop_length;
   h["n_freq"] = m.n_freq;
   h["max_len"] = m.max_len;
+  if (m.time_frames > 0 && m.time_frames != m.max_len) h["time_frames"] = m.time_frames;
   h["waveform_length"] = m.waveform_length;
   h["box_min"] = vec3(m.box_min);
   h["box_max"] = vec3(m.box_max);
@@ -391,8 +392,15 @@ void check_metadata(const ModelData& m, const std::string& name) {
   agree("win_length", m.win_length);
   agree("hop_length", m.hop_length);
   agree("n_freq", m.n_freq);
-  agree("max_len", m.max_len);
-  agree("waveform_length", m.waveform_length);
+  const auto own = audio->find("scene_frames");
+  if (own != audio->end() && audio->value("max_len", json()) != *own) {
+    // A scene of a multi-scene run at its own length: the manifest holds the run's frames.
+    agree("scene_frames", m.max_len);
+    agree("max_len", m.time_frames);
+  } else {
+    agree("max_len", m.max_len);
+    agree("waveform_length", m.waveform_length);
+  }
   agree("aabb_min", vec3(m.box_min));
   agree("aabb_max", vec3(m.box_max));
 }
@@ -416,6 +424,7 @@ void check_config(const ModelData& m, const std::string& name) {
     format_error(name, "n_freq " + std::to_string(m.n_freq) +
                            " is not n_fft/2 + 1 = " + std::to_string(m.n_fft / 2 + 1));
   check_range(m.max_len, 2, 1 << 16, "max_len (frames)", name);
+  if (m.time_frames != 0) check_range(m.time_frames, m.max_len, 1 << 16, "time_frames", name);
   check_range(m.waveform_length, 0, int64_t(1) << 26, "waveform_length", name);
   // The implicit length hop·(T − 1) gets the same bound: the RIR length sizes Griffin-Lim's
   // buffers at load, and neraf_model_info holds it in an int.
@@ -525,7 +534,7 @@ std::vector<uint8_t> serialize_model(const ModelData& m, const std::string& name
 
   std::vector<uint8_t> out(kMagic, kMagic + 8);
   out.reserve(payload.size() + kFileOverhead);
-  put_u32(out, kModelFormatVersion);
+  put_u32(out, m.time_frames > 0 && m.time_frames != m.max_len ? 2u : 1u);
   put_u32(out, m.bf16_storage ? kModelFlagBf16 : 0u);
   put_u64(out, payload.size());
   out.insert(out.end(), payload.begin(), payload.end());
@@ -624,6 +633,8 @@ ModelData parse_model(const uint8_t* data, size_t size, const std::string& name)
   m.hop_length = int(h.integer("hop_length", 1, 1 << 16));
   m.n_freq = int(h.integer("n_freq", 2, (1 << 15) + 1));
   m.max_len = int(h.integer("max_len", 2, 1 << 16));
+  if (version >= 2 && j.contains("time_frames"))
+    m.time_frames = int(h.integer("time_frames", 2, 1 << 16));
   m.waveform_length = h.integer("waveform_length", 0, int64_t(1) << 26);
   m.box_min = h.vec3("box_min");
   m.box_max = h.vec3("box_max");

@@ -35,7 +35,9 @@
 
 namespace neraf::rt {
 
-constexpr uint32_t kModelFormatVersion = 1;   // what write_model_file writes
+// What write_model_file writes: 1, or 2 for a file whose time encoding spans more frames than it
+// predicts (time_frames), which a reader of version 1 would encode wrongly.
+constexpr uint32_t kModelFormatVersion = 2;
 constexpr uint32_t kModelFlagBf16 = 1u << 0;  // weights stored as bfloat16
 
 // Input widths of the canonical NAcF input [time, mic, source, rot, relative geometry].
@@ -56,7 +58,10 @@ struct ModelData {
   int layout = 0;             // 0 soundspaces, 1 raf
   int sample_rate = 22050, channels = 2, n_fft = 512, win_length = 512, hop_length = 128;
   int n_freq = 257, max_len = 78;  // F, T
-  int64_t waveform_length = 0;     // samples per channel of a rendered RIR; 0 → hop·(T−1)
+  // The frames the time encoding spans, when more than the T predicted (a scene of a multi-scene
+  // run, at its own length of the run's longest); 0 = max_len.
+  int time_frames = 0;
+  int64_t waveform_length = 0;  // samples per channel of a rendered RIR; 0 → hop·(T−1)
   std::array<double, 3> box_min{}, box_max{};  // the audio aabb used to normalise positions
 
   // NAcF. Inputs in one canonical order, the scene feature already folded into trunk[0].bias:

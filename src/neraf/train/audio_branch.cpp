@@ -31,11 +31,14 @@ AudioBranch::AudioBranch(const TrainConfig& config, const data::RirSet& rirs,
 AudioBranch::AudioBranch(const TrainConfig& config, const std::vector<const data::RirSet*>& scenes,
                          const std::vector<nerf::NerfactoModel>& fields,
                          const std::vector<acoustic::WorldToField>& world_to_field,
-                         bool frozen_field, torch::Device device)
+                         bool frozen_field, torch::Device device,
+                         const std::vector<int64_t>& scene_frames)
     : config_(config), frozen_(frozen_field), device_(device) {
   TORCH_CHECK(
       !scenes.empty() && scenes.size() == fields.size() && scenes.size() == world_to_field.size(),
       "AudioBranch: one radiance field and world map per scene");
+  TORCH_CHECK(scene_frames.empty() || scene_frames.size() == scenes.size(),
+              "AudioBranch: one frame count per scene");
   require(scenes.size() == 1 || frozen_,
           "multi-scene: only --modality audio (each scene's frozen vision run) is implemented");
   const data::RirSet& first = *scenes.front();
@@ -63,6 +66,11 @@ AudioBranch::AudioBranch(const TrainConfig& config, const std::vector<const data
     sc.train_rirs = infer::audio_train_subset(*sc.rirs, config_.audio.fraction, config_.seed);
     sc.offset = n_train_;
     n_train_ += static_cast<int64_t>(sc.train_rirs.size());
+    sc.frames = scene_frames.empty() ? sc.rirs->max_len : scene_frames[s];
+    TORCH_CHECK(sc.frames >= 1 && sc.frames <= sc.rirs->max_len,
+                "AudioBranch: scene frames out of range");
+    sc.first_slice = n_slices_;
+    n_slices_ += static_cast<int64_t>(sc.train_rirs.size()) * sc.frames;
     // This scene's box (the scene's own pose normalisation and relative-distance scale) and map
     // into its radiance field's frame.
     sc.nacf = model_->options().nacf;
@@ -112,7 +120,7 @@ void AudioBranch::set_training(bool training) {
 
 std::pair<torch::Tensor, torch::Tensor> AudioBranch::sample_slices(at::Generator& gen, int64_t D) {
   const int64_t T = scenes_.front().rirs->max_len;
-  const int64_t n = n_train_ * T;
+  const int64_t n = n_slices_;
   const int64_t B = config_.audio.batch_size;
   const int64_t B_early = std::llround(config_.audio.early_fraction * static_cast<double>(B));
   const int64_t B_uniform = B - B_early;
@@ -131,9 +139,18 @@ std::pair<torch::Tensor, torch::Tensor> AudioBranch::sample_slices(at::Generator
     picks.insert(picks.end(), p, p + take);
     cursor_ += take;
   }
-  const torch::Tensor slice = torch::tensor(picks, torch::kInt64);
-  torch::Tensor local = torch::div(slice, T, "floor");  // position among all train RIRs
-  torch::Tensor frame = slice - local * T;
+  // Slice k of scene s (first_slice ≤ k < the next scene's): its train RIR offset + j / frames,
+  // frame j % frames, j = k − first_slice. (All frames equal: RIR k / T, frame k % T.)
+  std::vector<int64_t> rir_of(picks.size()), frame_of(picks.size());
+  for (size_t i = 0; i < picks.size(); ++i) {
+    size_t s = scenes_.size() - 1;
+    while (scenes_[s].first_slice > picks[i]) --s;
+    const int64_t j = picks[i] - scenes_[s].first_slice;
+    rir_of[i] = scenes_[s].offset + j / scenes_[s].frames;
+    frame_of[i] = j % scenes_[s].frames;
+  }
+  torch::Tensor local = torch::tensor(rir_of, torch::kInt64);  // position among all train RIRs
+  torch::Tensor frame = torch::tensor(frame_of, torch::kInt64);
   // Early share: random train RIRs, frames in [0, early_frames).
   const int64_t n_rirs = n_train_;
   if (B_early > 0) {
@@ -344,6 +361,10 @@ void AudioBranch::load(torch::serialize::InputArchive& archive, const std::strin
   torch::Tensor perm, cursor;
   archive.read("perm", perm);
   archive.read("cursor", cursor);
+  require(perm.numel() == 0 || perm.numel() == n_slices_,
+          where + ": checkpoint drew its batches from " + std::to_string(perm.numel()) +
+              " (RIR, frame) slices, this run has " + std::to_string(n_slices_) +
+              " (other RIRs or frames per RIR); use a new --out folder");
   perm_ = perm.numel() > 0 ? perm : torch::Tensor();
   cursor_ = cursor.item<int64_t>();
 }

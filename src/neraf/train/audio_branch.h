@@ -19,8 +19,11 @@
 // grid per scene, filled from that scene's frozen field, and ONE acoustic model (ResNet3D + NAcF)
 // over all of them. The epoch permutation runs over every scene's (RIR, frame) slices together,
 // so a batch mixes the scenes in proportion to their training RIRs; each scene's slices go
-// through ResNet3D on its own grid and NAcF with positions normalised by its own audio box. One
-// scene (N = 1) is the special case of the same code and draws exactly the same numbers.
+// through ResNet3D on its own grid and NAcF with positions normalised by its own audio box. The
+// scenes' features are padded to the longest scene's frames (one time encoding over all), but a
+// scene's uniform slices are drawn from its own frames only (scene_frames), so a small room's
+// batch share is not spent on padding. One scene (N = 1) is the special case of the same code
+// and draws exactly the same numbers.
 //
 // INFERENCE (render rir / loudness / auralize --run) does not need this class: use
 // infer/audio_run.h (load_audio_run + AudioRun::predict_log_stft); the model options and the
@@ -63,13 +66,14 @@ class AudioBranch : public Branch {
   AudioBranch(const infer::TrainConfig& config, const data::RirSet& rirs, nerf::NerfactoModel field,
               const acoustic::WorldToField& world_to_field, bool frozen_field,
               torch::Device device);
-  // Multi-scene: scene s has `scenes[s]`, its frozen field `fields[s]` and its map
-  // `world_to_field[s]` (N ≥ 1, same sizes; N ≥ 2 needs frozen fields). The RirSets must share
-  // channels, frequencies and frames per RIR.
+  // Multi-scene: scene s has `scenes[s]`, its frozen field `fields[s]`, its map
+  // `world_to_field[s]` (N ≥ 1, same sizes; N ≥ 2 needs frozen fields) and its own frames per RIR
+  // `scene_frames[s]` (2..max_len; empty: max_len). The RirSets must share channels, frequencies
+  // and frames per RIR.
   AudioBranch(const infer::TrainConfig& config, const std::vector<const data::RirSet*>& scenes,
               const std::vector<nerf::NerfactoModel>& fields,
               const std::vector<acoustic::WorldToField>& world_to_field, bool frozen_field,
-              torch::Device device);
+              torch::Device device, const std::vector<int64_t>& scene_frames = {});
 
   std::string name() const override { return "audio"; }
   std::vector<ParamGroup> param_groups() override;
@@ -99,12 +103,14 @@ class AudioBranch : public Branch {
     acoustic::GridSampler grid{nullptr};
     std::vector<int64_t> train_rirs;  // indices into rirs->rirs
     int64_t offset = 0;               // position of its first train RIR among all scenes'
+    int64_t frames = 0;               // its own frames per RIR (uniform slices are drawn below)
+    int64_t first_slice = 0;          // position of its first slice in the epoch permutation
     acoustic::NacfOptions nacf;  // the model's NAcF options with this scene's box and world map
   };
   // The step's (train RIR, frame) pairs, each [B + D·T] int64, the RIR as a position among all
   // scenes' train RIRs (scene s owns [offset, offset + its count)): batch_size slices (the
-  // uniform share from the epoch permutation, then the early share), then D whole RIRs for the
-  // energy-decay loss (D = 0 when it is off).
+  // uniform share from the epoch permutation over every scene's own slices, then the early
+  // share), then D whole RIRs for the energy-decay loss (D = 0 when it is off).
   std::pair<torch::Tensor, torch::Tensor> sample_slices(at::Generator& gen, int64_t D);
   // Multi-scene losses' forward: the slices sorted by scene within the batch and the whole-RIR
   // part (each scene's ResNet3D feature once, NAcF in its box) → {pred, gt}, each [B + D·T, C, F].
@@ -116,10 +122,11 @@ class AudioBranch : public Branch {
   torch::Device device_;
   acoustic::AcousticModel model_{nullptr};
   std::vector<Scene> scenes_;
-  int64_t n_train_ = 0;  // train RIRs of all scenes
-  torch::Tensor perm_;   // [n_train·max_len] int64: this epoch's slice order
-  int64_t cursor_ = 0;   // next position in perm_
-  torch::Tensor batch_;  // [B + D·T, C, F] float32 gather buffer
+  int64_t n_train_ = 0;   // train RIRs of all scenes
+  int64_t n_slices_ = 0;  // their (RIR, frame) slices, each scene's own frames
+  torch::Tensor perm_;    // [n_slices] int64: this epoch's slice order
+  int64_t cursor_ = 0;    // next position in perm_
+  torch::Tensor batch_;   // [B + D·T, C, F] float32 gather buffer
   SaturationWatch saturation_;
 };
 

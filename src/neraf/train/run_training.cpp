@@ -94,6 +94,7 @@ struct SceneData {
   data::ImageSet images;
   nlohmann::json manifest;
   std::unique_ptr<data::RirSet> rirs;
+  int64_t frames = 0;  // its own frames per RIR (multi-scene: ≤ the run's, to which rirs is padded)
 };
 
 data::RirSet load_rirs(const TrainConfig& cfg, const TrainRunOptions& options,
@@ -110,7 +111,9 @@ data::RirSet load_rirs(const TrainConfig& cfg, const TrainRunOptions& options,
 // The scenes of a multi-scene run (cfg.audio.vision_runs[s] is scene s's vision run), each checked
 // against its vision run, all of one layout, sample rate and STFT, and all with the same frames
 // per RIR: without --max-len the longest scene's automatic value, recorded in cfg.audio.max_len so
-// resume and eval load the same features. `old` is the run's data.json on resume.
+// resume and eval load the same features. Each scene keeps its own automatic length as
+// SceneData::frames (its manifest's audio.scene_frames): training draws its frames below it, eval
+// and render cut its RIRs to it. `old` is the run's data.json on resume.
 std::vector<SceneData> load_scenes(TrainConfig& cfg, const TrainRunOptions& options,
                                    const std::vector<std::string>& data_dirs,
                                    const nlohmann::json& old, bool resuming) {
@@ -140,6 +143,7 @@ std::vector<SceneData> load_scenes(TrainConfig& cfg, const TrainRunOptions& opti
                                       "rate and STFT: synthesise or convert them alike");
     }
     longest = std::max(longest, sc.rirs->max_len);
+    sc.frames = sc.rirs->max_len;
     scenes.push_back(std::move(sc));
   }
   if (cfg.audio.max_len == 0)
@@ -158,8 +162,19 @@ std::vector<SceneData> load_scenes(TrainConfig& cfg, const TrainRunOptions& opti
       const nlohmann::json& was = old["scenes"][s];
       check_resumed_images(was, sc.manifest, sc.data_dir);
       if (was.contains("audio")) infer::check_audio_manifest(was["audio"], *sc.rirs, sc.data_dir);
+      // As it trained (a run from before own lengths: the common length).
+      sc.frames = sc.rirs->max_len;
+      if (was.contains("audio") && was["audio"].contains("scene_frames")) {
+        const nlohmann::json& f = was["audio"]["scene_frames"];
+        require(
+            f.is_number_integer() && f.get<int64_t>() >= 2 && f.get<int64_t>() <= sc.rirs->max_len,
+            options.run_dir + "/data.json: damaged (scene " + names[s] +
+                "'s audio.scene_frames); restore it or train a new run");
+        sc.frames = f.get<int64_t>();
+      }
     }
     sc.manifest["audio"] = infer::make_audio_manifest(*sc.rirs);
+    sc.manifest["audio"]["scene_frames"] = sc.frames;
     sc.manifest["name"] = names[s];
   }
   return scenes;
@@ -188,14 +203,15 @@ std::string comparable_manifest(nlohmann::json manifest) {
 
 // A new cpu run without --steps: as many audio steps as its data needs (infer::
 // fit_run_length_to_data); every rank computes the same from the same data.
+// `frames`: each scene's own frames per RIR (empty: its max_len).
 void fit_run_length(TrainConfig& cfg, const std::vector<const data::RirSet*>& scenes, bool resume,
-                    bool lead) {
+                    bool lead, const std::vector<int64_t>& frames = {}) {
   if (resume || scenes.empty()) return;
   int64_t slices = 0;
-  for (const data::RirSet* r : scenes)
-    slices +=
-        static_cast<int64_t>(infer::audio_train_subset(*r, cfg.audio.fraction, cfg.seed).size()) *
-        r->max_len;
+  for (size_t s = 0; s < scenes.size(); ++s)
+    slices += static_cast<int64_t>(
+                  infer::audio_train_subset(*scenes[s], cfg.audio.fraction, cfg.seed).size()) *
+              (frames.empty() ? scenes[s]->max_len : frames[s]);
   const infer::RunLengthFit fit = infer::fit_run_length_to_data(cfg, slices);
   if (lead && fit.audio_steps_after != fit.audio_steps_before)
     info("cpu preset: " + std::to_string(slices) + " training (RIR, frame) slices, so " +
@@ -310,12 +326,14 @@ TrainRunSummary train_run_folder(const TrainConfig& config_in, const TrainRunOpt
                 std::to_string(cfg.audio.vision_runs.size()) + " --vision-run)");
     scenes = load_scenes(cfg, options, dirs, old_manifest, resume_from.has_value());
     manifest = {{"format", "neraf-run-data-1"}, {"scenes", nlohmann::json::array()}};
+    std::vector<int64_t> frames;
     for (const SceneData& sc : scenes) {
       manifest["scenes"].push_back(sc.manifest);
       all_rirs.push_back(sc.rirs.get());
+      frames.push_back(sc.frames);
     }
-    fit_run_length(cfg, all_rirs, options.resume, lead);
-    trainer = make_multiscene_trainer(cfg, all_rirs, options.device);
+    fit_run_length(cfg, all_rirs, options.resume, lead, frames);
+    trainer = make_multiscene_trainer(cfg, all_rirs, options.device, frames);
   } else {
     require(options.scene_data_dirs.empty(),
             "--data: given " + std::to_string(options.scene_data_dirs.size()) +

@@ -356,7 +356,8 @@ std::unique_ptr<Trainer> make_trainer(const TrainConfig& config, const data::Ima
 
 std::unique_ptr<Trainer> make_multiscene_trainer(const TrainConfig& config,
                                                  const std::vector<const data::RirSet*>& scenes,
-                                                 torch::Device device) {
+                                                 torch::Device device,
+                                                 const std::vector<int64_t>& scene_frames) {
   validate(config, "config");
   require(config.modality == Modality::audio && config.audio.vision_runs.size() == scenes.size(),
           "multi-scene: one --vision-run per --data (--modality audio)");
@@ -370,7 +371,7 @@ std::unique_ptr<Trainer> make_multiscene_trainer(const TrainConfig& config,
     maps.push_back(world_to_field_of(config, vision));
   }
   trainer->add_branch(std::make_unique<AudioBranch>(config, scenes, fields, maps,
-                                                    /*frozen_field=*/true, device));
+                                                    /*frozen_field=*/true, device, scene_frames));
   return trainer;
 }
 

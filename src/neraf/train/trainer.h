@@ -191,9 +191,11 @@ std::unique_ptr<Trainer> make_trainer(const infer::TrainConfig& config,
                                       const data::ImageSet* images, torch::Device device,
                                       const data::RirSet* rirs = nullptr);
 // A multi-scene audio run (config.audio.vision_runs, N ≥ 2): scene s trains on `scenes[s]` with
-// the frozen radiance field of config.audio.vision_runs[s] (audio_branch.h, "Multi-scene").
+// the frozen radiance field of config.audio.vision_runs[s] (audio_branch.h, "Multi-scene"), on
+// its first `scene_frames[s]` frames per RIR (empty: all of them).
 std::unique_ptr<Trainer> make_multiscene_trainer(const infer::TrainConfig& config,
                                                  const std::vector<const data::RirSet*>& scenes,
-                                                 torch::Device device);
+                                                 torch::Device device,
+                                                 const std::vector<int64_t>& scene_frames = {});
 
 }  // namespace neraf::train
