@@ -77,7 +77,7 @@ typedef struct neraf_pose {
 } neraf_pose;
 
 typedef struct neraf_model_info {
-  uint32_t format_version;
+  uint32_t format_version; /* the file's format: 1, or 2 for a shorter scene of a multi-scene run */
   int layout;         /* 0 SoundSpaces (binaural), 1 RAF (mono) */
   int sample_rate;    /* Hz */
   int channels;       /* C */

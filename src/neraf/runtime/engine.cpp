@@ -94,7 +94,7 @@ Engine::Engine(const ModelData& m, const std::string& name, bool allow_bf16) {
   calibration_ = m.calibration;
   griffin_lim_ = std::make_unique<GriffinLim>(m.n_fft, m.win_length, m.hop_length, n_frames_);
 
-  info_.format_version = kModelFormatVersion;
+  info_.format_version = format_version_of(m);  // the file's: 1 unless it needs time_frames
   info_.layout = m.layout;
   info_.sample_rate = m.sample_rate;
   info_.channels = m.channels;

@@ -534,7 +534,7 @@ std::vector<uint8_t> serialize_model(const ModelData& m, const std::string& name
 
   std::vector<uint8_t> out(kMagic, kMagic + 8);
   out.reserve(payload.size() + kFileOverhead);
-  put_u32(out, m.time_frames > 0 && m.time_frames != m.max_len ? 2u : 1u);
+  put_u32(out, format_version_of(m));
   put_u32(out, m.bf16_storage ? kModelFlagBf16 : 0u);
   put_u64(out, payload.size());
   out.insert(out.end(), payload.begin(), payload.end());

@@ -89,6 +89,11 @@ struct ModelData {
 
 // What read_model_file / parse_model / check_model_data throw: a status of neraf_rt.h
 // (NERAF_ERR_IO, NERAF_ERR_FORMAT, NERAF_ERR_VERSION) and a one-line message naming the file.
+// The format a file of `m` is written in (1, or 2 when it needs time_frames).
+inline uint32_t format_version_of(const ModelData& m) {
+  return m.time_frames > 0 && m.time_frames != m.max_len ? 2u : 1u;
+}
+
 class ModelFileError : public std::runtime_error {
  public:
   ModelFileError(neraf_status status, const std::string& message)
