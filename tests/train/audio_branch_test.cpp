@@ -170,6 +170,24 @@ TEST(AudioBranch, MismatchedDatasetOrPresetIsAClearError) {
   EXPECT_THROW(infer::check_checkpoint_header(arch, paper, path), Error);
 }
 
+// A trainer over two scenes, each with its own frozen random field (seeds field_seed and
+// field_seed + 1), its world map `maps[s]` and its own frames `frames` (empty: all).
+std::unique_ptr<Trainer> two_scene_trainer(
+    const TrainConfig& c, const data::RirSet& a, const data::RirSet& b, uint64_t field_seed,
+    const std::vector<acoustic::WorldToField>& maps = {acoustic::kIdentityWorldToField,
+                                                       acoustic::kIdentityWorldToField},
+    const std::vector<int64_t>& frames = {}) {
+  auto t = std::make_unique<Trainer>(c, torch::kCPU);
+  std::vector<nerf::NerfactoModel> fields;
+  for (uint64_t k = 0; k < 2; ++k) {
+    fields.emplace_back(c.model, 4, field_seed + k);  // two different frozen fields
+    for (auto& p : fields.back()->parameters()) p.set_requires_grad(false);
+  }
+  t->add_branch(std::make_unique<AudioBranch>(c, std::vector<const data::RirSet*>{&a, &b}, fields,
+                                              maps, /*frozen_field=*/true, torch::kCPU, frames));
+  return t;
+}
+
 // Multi-scene: two rooms (the second with one point moved, so its box and RIRs differ), each with
 // its own frozen field and grid, one acoustic model; a batch mixes both; the checkpoint resumes
 // exactly and is refused by a one-scene branch.
@@ -180,19 +198,7 @@ TEST(AudioBranch, MultiSceneStepsOverBothScenesAndResumesExactly) {
   const data::RirSet b = tiny_rir_set(dir + "/b", /*move_a_point=*/true);
   TrainConfig c = tiny_joint_config();
   c.modality = infer::Modality::audio;
-  auto make = [&](uint64_t field_seed) {
-    auto t = std::make_unique<Trainer>(c, torch::kCPU);
-    std::vector<nerf::NerfactoModel> fields;
-    for (uint64_t k = 0; k < 2; ++k) {
-      fields.emplace_back(c.model, 4, field_seed + k);  // two different frozen fields
-      for (auto& p : fields.back()->parameters()) p.set_requires_grad(false);
-    }
-    t->add_branch(std::make_unique<AudioBranch>(
-        c, std::vector<const data::RirSet*>{&a, &b}, fields,
-        std::vector<acoustic::WorldToField>(2, acoustic::kIdentityWorldToField),
-        /*frozen_field=*/true, torch::kCPU));
-    return t;
-  };
+  auto make = [&](uint64_t field_seed) { return two_scene_trainer(c, a, b, field_seed); };
   auto t = make(7);
   auto* audio = dynamic_cast<AudioBranch*>(t->branch("audio"));
   ASSERT_EQ(audio->num_scenes(), 2u);
@@ -238,17 +244,8 @@ TEST(AudioBranch, MultiSceneDrawsEachScenesOwnFrames) {
   ASSERT_GT(T, 2);
   auto make = [&](const std::vector<int64_t>& frames) {
     torch::manual_seed(0);
-    auto t = std::make_unique<Trainer>(c, torch::kCPU);
-    std::vector<nerf::NerfactoModel> fields;
-    for (uint64_t k = 0; k < 2; ++k) {
-      fields.emplace_back(c.model, 4, 7 + k);
-      for (auto& p : fields.back()->parameters()) p.set_requires_grad(false);
-    }
-    t->add_branch(std::make_unique<AudioBranch>(
-        c, std::vector<const data::RirSet*>{&a, &b}, fields,
-        std::vector<acoustic::WorldToField>(2, acoustic::kIdentityWorldToField),
-        /*frozen_field=*/true, torch::kCPU, frames));
-    return t;
+    return two_scene_trainer(
+        c, a, b, 7, {acoustic::kIdentityWorldToField, acoustic::kIdentityWorldToField}, frames);
   };
   auto saved_perm = [&](Trainer& t, const std::string& path) {
     t.save_checkpoint(path);
@@ -291,16 +288,7 @@ TEST(AudioBranch, MultiScenePerQueryFeaturesUseEachScenesWorldMap) {
   const acoustic::WorldToField shifted = {0.5, 0, 0, 0.3, 0, 0.5, 0, 0, 0, 0, 0.5, -0.2};
   auto first_loss = [&](const acoustic::WorldToField& second_map) {
     torch::manual_seed(11);
-    auto t = std::make_unique<Trainer>(c, torch::kCPU);
-    std::vector<nerf::NerfactoModel> fields;
-    for (uint64_t k = 0; k < 2; ++k) {
-      fields.emplace_back(c.model, 4, 7 + k);
-      for (auto& p : fields.back()->parameters()) p.set_requires_grad(false);
-    }
-    t->add_branch(std::make_unique<AudioBranch>(
-        c, std::vector<const data::RirSet*>{&a, &b}, fields,
-        std::vector<acoustic::WorldToField>{acoustic::kIdentityWorldToField, second_map},
-        /*frozen_field=*/true, torch::kCPU));
+    auto t = two_scene_trainer(c, a, b, 7, {acoustic::kIdentityWorldToField, second_map});
     const StepResult r = t->step();
     EXPECT_TRUE(std::isfinite(r.losses.at("audio_mag_loss")));
     return r.losses.at("audio_mag_loss");
