@@ -9,7 +9,7 @@
 #      three rooms with --grid sampled, zeros and none, of 3 × AUDIO_STEPS steps: the same total
 #      number of training slices as the three single runs together (the compute budget of
 #      training them separately), which the batches spread over the rooms in proportion to their
-#      training RIRs (and frames: the rooms share the longest room's frame count);
+#      training slices (RIRs × each room's own frames);
 #      and, as a control for the multi-scene run's 3× optimizer steps, one run per room on its own
 #      with 3 × AUDIO_STEPS steps too ("single_long");
 #   4. `neraf eval` of every run on each room's held-out split; per-RIR paired differences
