@@ -98,15 +98,15 @@ NERAF_RT_API const char* neraf_status_string(neraf_status status);
 
 /* Model. */
 NERAF_RT_API neraf_status neraf_model_load(const char* path, neraf_model** out);
-/* Load flags. A model exported in bfloat16 (`neraf export --precision bf16`) runs its trunk in
- * bfloat16 where the CPU can: on AMX-BF16 tiles (Intel Sapphire Rapids and later: several times
- * faster), else with AVX512-BF16 (Intel Cooper Lake, AMD Zen 4 and later); activations rounded to
- * bfloat16 as in training, ~1e-2 from the float32 result in log-magnitude. Elsewhere it runs in
- * float32 with its bfloat16-rounded weights. */
+/* Load flags. A model exported in bfloat16 (`neraf export --precision bf16`) runs its trunk and
+ * heads in bfloat16 where the CPU can: on AMX-BF16 tiles (Intel Sapphire Rapids and later:
+ * several times faster), else with AVX512-BF16 (Intel Cooper Lake, AMD Zen 4 and later);
+ * activations rounded to bfloat16 as in training, ~1e-2 from the float32 result in
+ * log-magnitude. Elsewhere it runs in float32 with its bfloat16-rounded weights. */
 #define NERAF_LOAD_FLOAT32 1u /* compute in float32 even where bfloat16 is available */
 NERAF_RT_API neraf_status neraf_model_load_ex(const char* path, unsigned flags, neraf_model** out);
-/* What the model's trunk computes in: "float32", "bfloat16-amx" or "bfloat16-avx512" (static
- * storage). */
+/* What the model's trunk and heads compute in: "float32", "bfloat16-amx" or "bfloat16-avx512"
+ * (static storage). */
 NERAF_RT_API const char* neraf_model_compute(const neraf_model* model);
 NERAF_RT_API void neraf_model_free(neraf_model* model); /* NULL is a no-op */
 NERAF_RT_API neraf_status neraf_model_get_info(const neraf_model* model, neraf_model_info* out);

@@ -83,11 +83,14 @@ Engine::Engine(const ModelData& m, const std::string& name, bool allow_bf16) {
     }
   }
   const int w = int(m.heads[0].in);
-  head_weight_.resize(size_t(channels_) * n_freq_ * w);
+  if (!bf16_trunk()) head_weight_.resize(size_t(channels_) * n_freq_ * w);
   head_bias_.resize(size_t(channels_) * n_freq_);
   for (int c = 0; c < channels_; ++c) {
-    std::copy(m.heads[c].weight.begin(), m.heads[c].weight.end(),
-              head_weight_.begin() + size_t(c) * n_freq_ * w);
+    if (bf16_trunk())
+      bf16_heads_.emplace_back(m.heads[c].weight.data(), n_freq_, w, bf16_kernel_);
+    else
+      std::copy(m.heads[c].weight.begin(), m.heads[c].weight.end(),
+                head_weight_.begin() + size_t(c) * n_freq_ * w);
     std::copy(m.heads[c].bias.begin(), m.heads[c].bias.end(),
               head_bias_.begin() + size_t(c) * n_freq_);
   }
@@ -177,8 +180,11 @@ void Engine::query(const neraf_pose& pose, Workspace& ws, float* log, float* wav
   // threads the products itself: then one product for all heads first). A log-STFT query with
   // its heads done has too little left per channel to repay waking a helper.
   int n_workers = std::min<int>(channels_, int(ws.helpers_.size()) + 1);
-  const bool heads_per_channel = single_blas && n_workers > 1;
-  if (!heads_per_channel) {
+  const bool heads_per_channel = bf16_trunk() || (single_blas && n_workers > 1);
+  if (bf16_trunk()) {  // the heads' input, packed once for every channel's product
+    pack_activations(x, T, width, ld, padded_frames_, bf16_heads_[0].in_padded(),
+                     ws.x_tiles_.data());
+  } else if (!heads_per_channel) {
     // log[C·F, T] = W_heads[C·F, W]·xᵀ: rows (c, f), columns t, the [C, F, T] layout itself.
     cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, channels_ * n_freq_, T, width, 1.0f,
                 head_weight_.data(), width, x, int(ld), 0.0f, log, T);
@@ -251,14 +257,29 @@ void Engine::channels(const ChannelPart& p) const {
   const float scale = output_scale_;
   for (int c = p.worker; c < channels_; c += p.n_workers) {
     float* log = p.log + c * ft;  // [F, T]
-    if (p.heads)
-      cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, F, T, p.width, 1.0f,
-                  head_weight_.data() + c * size_t(F) * p.width, p.width, p.x, int(p.ld_x), 0.0f,
-                  log, T);
-    for (int f = 0; f < F; ++f) {  // output_scale·tanh(. + bias)
-      float* o = log + size_t(f) * T;
-      const float b = head_bias_[size_t(c) * F + f];
-      for (int t = 0; t < T; ++t) o[t] = tanh_approx(o[t] + b) * scale;
+    const float* bias = head_bias_.data() + size_t(c) * F;
+    if (bf16_trunk()) {
+      // y[padded T, padded F] = bf16(x)·bf16(W_c)ᵀ (x packed by query()), then output_scale·
+      // tanh(. + bias) along each frame's row and the transpose into [F, T].
+      const Bf16Matrix& head = bf16_heads_[c];
+      const size_t ld_y = size_t(head.out_padded());
+      float* y = p.ws->head_products_.data() + c * size_t(padded_frames_) * ld_y;
+      head.multiply(p.ws->x_tiles_.data(), padded_frames_, y, 0, head.out_padded());
+      for (int t = 0; t < T; ++t) {
+        float* yt = y + size_t(t) * ld_y;
+        for (int f = 0; f < F; ++f) yt[f] = tanh_approx(yt[f] + bias[f]) * scale;
+      }
+      for (int f = 0; f < F; ++f)
+        for (int t = 0; t < T; ++t) log[size_t(f) * T + t] = y[size_t(t) * ld_y + f];
+    } else {
+      if (p.heads)
+        cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, F, T, p.width, 1.0f,
+                    head_weight_.data() + c * size_t(F) * p.width, p.width, p.x, int(p.ld_x), 0.0f,
+                    log, T);
+      for (int f = 0; f < F; ++f) {  // output_scale·tanh(. + bias)
+        float* o = log + size_t(f) * T;
+        for (int t = 0; t < T; ++t) o[t] = tanh_approx(o[t] + bias[f]) * scale;
+      }
     }
     if (!calibration_.empty()) {
       // log(clip(e^x − 1e-3, 0, 1e4)·g + 1e-3) (acoustic::apply_calibration).
@@ -281,7 +302,11 @@ Workspace::Workspace(const Engine& engine, int threads) : engine_(engine) {
   act_b_ = alloc_fftw_floats(rows * engine.max_width_);
   size_t max_in = 0;
   for (const Bf16Matrix& a : engine.bf16_layers_) max_in = std::max(max_in, size_t(a.in_padded()));
+  for (const Bf16Matrix& a : engine.bf16_heads_) max_in = std::max(max_in, size_t(a.in_padded()));
   x_tiles_.assign(rows * max_in, 0);
+  if (!engine.bf16_heads_.empty())
+    head_products_.assign(engine.bf16_heads_.size() * rows * engine.bf16_heads_[0].out_padded(),
+                          0.0f);
   log_stft_.assign(engine.log_stft_size(), 0.0f);
   phases_.assign(size_t(engine.channels_) * engine.n_frames_ * engine.griffin_lim_->phase_stride(),
                  0.0f);

@@ -7,17 +7,19 @@
 //   W1·[enc_time(t); pose] + b1 = table[t] + u,   table[t] = W1_time·enc_time(t) + b1 ([T, H1],
 //   computed once at load, in double), u = W1_pose·pose (one gemv per RIR).
 // Then h1 = leaky(table + u) ([T, H1]), each further trunk layer one sgemm over all T frames, the
-// heads one sgemm that writes [C·F, T] = the output layout directly (no transpose), then
+// heads one sgemm that writes [C·F, T] = the output layout directly (the bf16 path: one product
+// [T, F] per channel, transposed after the tanh), then
 // output_scale·tanh, the energy calibration log(clip(e^x − 1e-3, 0, 1e4)·g + 1e-3) and, for
 // waveforms, magnitudes clip(e^x − 1e-3, 0, 1e4) into Griffin-Lim (one channel per thread).
 //
 // Precision: float32, except for a model stored in bfloat16 (exported with --precision bf16,
 // trained with a bf16 trunk) on a CPU with AMX-BF16 or AVX512-BF16: its trunk layers after the
-// first then run in bfloat16 (bf16_gemm.h: activations rounded to bf16 before each layer, float32
-// accumulation, as the training code's bf16 trunk; ~1e-2 from the float32 result in
-// log-magnitude), unless the caller asks for float32. Layer 1 (time table + pose gemv) and the
-// heads always run in float32, as in training. Elsewhere a bf16 file runs its bf16-rounded
-// weights in float32.
+// first and its heads then run in bfloat16 (bf16_gemm.h: inputs rounded to bf16 before each
+// product, float32 accumulation; ~1e-2 from the float32 result in log-magnitude), unless the
+// caller asks for float32. The training code's bf16 trunk rounds the same inputs: its
+// activations between trunk layers, the heads' input included, are bf16, and a bf16 file's head
+// weights are rounded already. Layer 1 (time table + pose gemv) runs in float32, as in training.
+// Elsewhere a bf16 file runs its bf16-rounded weights in float32.
 // The encodings run in double where the training code's do (positions, rot, relative geometry),
 // the time encoding in float; exp, log and tanh are vectorised approximations (vector_math.h),
 // so float32 results match the torch path to float rounding, not bit for bit.
@@ -55,7 +57,7 @@ class Engine {
   // out of memory.
   explicit Engine(const ModelData& m, const std::string& name = "model", bool allow_bf16 = true);
 
-  // The kernel of the trunk's bfloat16 products, or none when the trunk runs in float32.
+  // The kernel of the bfloat16 products (trunk and heads), or none when they run in float32.
   Bf16Kernel bf16_kernel() const { return bf16_kernel_; }
   bool bf16_trunk() const { return bf16_kernel_ != Bf16Kernel::none; }
   int channels() const { return channels_; }
@@ -126,7 +128,8 @@ class Engine {
   std::vector<float> w1_pose_;           // [H1, pose_dim]: trunk[0]'s pose columns
   std::vector<Layer> layers_;            // trunk[1..] (weights float32; biases used by both paths)
   std::vector<Bf16Matrix> bf16_layers_;  // trunk[1..] packed (bf16 path), else empty
-  std::vector<float> head_weight_;       // [C·F, W]: the heads stacked
+  std::vector<float> head_weight_;       // [C·F, W]: the heads stacked (float32 path)
+  std::vector<Bf16Matrix> bf16_heads_;   // [C]: each channel's head packed (bf16 path)
   std::vector<float> head_bias_;         // [C·F]
   std::vector<float> calibration_;       // [C, F, T] or empty
   std::unique_ptr<GriffinLim> griffin_lim_;
@@ -154,7 +157,8 @@ class Workspace {
   std::vector<float> pose_;            // [pose_dim]
   std::vector<float> u_;               // [H1]: W1_pose·pose
   FftwFloats act_a_, act_b_;           // [padded T, max width]: trunk activations (ping-pong)
-  std::vector<uint16_t> x_tiles_;      // the AMX path's bf16 input tiles [padded T, padded width]
+  std::vector<uint16_t> x_tiles_;      // the bf16 path's input tiles [padded T, padded width]
+  std::vector<float> head_products_;   // the bf16 path's heads [C][padded T, padded F]
   std::vector<float> log_stft_;        // [C, F, T]: rir()'s log-STFT, then its magnitudes
   std::vector<float> phases_;          // [C][T][2F]: Griffin-Lim's initial phases for seed_
   std::vector<GriffinLimBuffers> gl_;  // [C]
