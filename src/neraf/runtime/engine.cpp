@@ -176,9 +176,10 @@ void Engine::query(const neraf_pose& pose, Workspace& ws, float* log, float* wav
     ld = ld_y;
   }
 
-  // The channels: with helpers, each thread takes whole channels (and their heads, unless BLAS
-  // threads the products itself: then one product for all heads first). A log-STFT query with
-  // its heads done has too little left per channel to repay waking a helper.
+  // The channels: with helpers, each thread takes whole channels and their heads (always on the
+  // bf16 path; on the float32 path unless BLAS threads the products itself: then one product for
+  // all heads first). A log-STFT query with its heads done has too little left per channel to
+  // repay waking a helper.
   int n_workers = std::min<int>(channels_, int(ws.helpers_.size()) + 1);
   const bool heads_per_channel = bf16_trunk() || (single_blas && n_workers > 1);
   if (bf16_trunk()) {  // the heads' input, packed once for every channel's product
