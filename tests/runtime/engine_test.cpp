@@ -266,7 +266,7 @@ TEST(Engine, MatchesTheReferenceFromBfloat16Storage) {
 // the reference reproduces by rounding the input of each product to bfloat16 (what is left: float32
 // summation order, and the rare activation that rounds the other way). Against the float32
 // reference, the bf16 error.
-TEST(Engine, Bfloat16Trunk) {
+TEST(Engine, Bfloat16TrunkAndHeads) {
   RandomModelOptions o;
   o.bf16 = true;
   o.relative_geometry = true;

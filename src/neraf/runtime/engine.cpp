@@ -70,10 +70,10 @@ Engine::Engine(const ModelData& m, const std::string& name, bool allow_bf16) {
     }
   }
   if (allow_bf16 && m.bf16_storage && m.trunk.size() > 1) bf16_kernel_ = best_bf16_kernel();
-  padded_frames_ = bf16_trunk() ? round_up(n_frames_, kTileRows) : n_frames_;
+  padded_frames_ = bf16_network() ? round_up(n_frames_, kTileRows) : n_frames_;
   for (size_t i = 1; i < m.trunk.size(); ++i) {
     const DenseLayer& d = m.trunk[i];
-    if (bf16_trunk()) {
+    if (bf16_network()) {
       bf16_layers_.emplace_back(d.weight.data(), int(d.out), int(d.in), bf16_kernel_);
       layers_.push_back({int(d.in), int(d.out), {}, d.bias});  // float32 weights not needed
       max_width_ = std::max(max_width_, bf16_layers_.back().out_padded());
@@ -83,10 +83,10 @@ Engine::Engine(const ModelData& m, const std::string& name, bool allow_bf16) {
     }
   }
   const int w = int(m.heads[0].in);
-  if (!bf16_trunk()) head_weight_.resize(size_t(channels_) * n_freq_ * w);
+  if (!bf16_network()) head_weight_.resize(size_t(channels_) * n_freq_ * w);
   head_bias_.resize(size_t(channels_) * n_freq_);
   for (int c = 0; c < channels_; ++c) {
-    if (bf16_trunk())
+    if (bf16_network())
       bf16_heads_.emplace_back(m.heads[c].weight.data(), n_freq_, w, bf16_kernel_);
     else
       std::copy(m.heads[c].weight.begin(), m.heads[c].weight.end(),
@@ -161,7 +161,7 @@ void Engine::query(const neraf_pose& pose, Workspace& ws, float* log, float* wav
   size_t ld = size_t(h1);
   for (size_t i = 0; i < layers_.size(); ++i) {
     const Layer& l = layers_[i];
-    const size_t ld_y = bf16_trunk() ? size_t(bf16_layers_[i].out_padded()) : size_t(l.out);
+    const size_t ld_y = bf16_network() ? size_t(bf16_layers_[i].out_padded()) : size_t(l.out);
     trunk_layer(i, ws, x, ld, y, ld_y, single_blas);
     for (int t = 0; t < T; ++t) {  // + bias, LeakyReLU
       float* yt = y + size_t(t) * ld_y;
@@ -181,8 +181,8 @@ void Engine::query(const neraf_pose& pose, Workspace& ws, float* log, float* wav
   // all heads first). A log-STFT query with its heads done has too little left per channel to
   // repay waking a helper.
   int n_workers = std::min<int>(channels_, int(ws.helpers_.size()) + 1);
-  const bool heads_per_channel = bf16_trunk() || (single_blas && n_workers > 1);
-  if (bf16_trunk()) {  // the heads' input, packed once for every channel's product
+  const bool heads_per_channel = bf16_network() || (single_blas && n_workers > 1);
+  if (bf16_network()) {  // the heads' input, packed once for every channel's product
     pack_activations(x, T, width, ld, padded_frames_, bf16_heads_[0].in_padded(),
                      ws.x_tiles_.data());
   } else if (!heads_per_channel) {
@@ -210,7 +210,7 @@ void Engine::trunk_layer(size_t i, Workspace& ws, const float* x, size_t ld_x, f
   const Layer& l = layers_[i];
   const int T = n_frames_;
   int n = l.out, granule = 16;
-  if (bf16_trunk()) {
+  if (bf16_network()) {
     const Bf16Matrix& a = bf16_layers_[i];
     pack_activations(x, T, l.in, ld_x, padded_frames_, a.in_padded(), ws.x_tiles_.data());
     n = a.out_padded();
@@ -239,7 +239,7 @@ void Engine::trunk_layer(size_t i, Workspace& ws, const float* x, size_t ld_x, f
 
 void Engine::layer_columns(const LayerPart& p) const {
   if (p.n_begin >= p.n_end) return;
-  if (bf16_trunk()) {
+  if (bf16_network()) {
     // y[padded T, columns] = bf16(x)·bf16(W)ᵀ (x packed by trunk_layer).
     bf16_layers_[p.layer].multiply(p.ws->x_tiles_.data(), padded_frames_, p.y, p.n_begin, p.n_end);
   } else {
@@ -259,7 +259,7 @@ void Engine::channels(const ChannelPart& p) const {
   for (int c = p.worker; c < channels_; c += p.n_workers) {
     float* log = p.log + c * ft;  // [F, T]
     const float* bias = head_bias_.data() + size_t(c) * F;
-    if (bf16_trunk()) {
+    if (bf16_network()) {
       // y[padded T, padded F] = bf16(x)·bf16(W_c)ᵀ (x packed by query()), then output_scale·
       // tanh(. + bias) along each frame's row and the transpose into [F, T].
       const Bf16Matrix& head = bf16_heads_[c];

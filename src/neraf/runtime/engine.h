@@ -59,7 +59,8 @@ class Engine {
 
   // The kernel of the bfloat16 products (trunk and heads), or none when they run in float32.
   Bf16Kernel bf16_kernel() const { return bf16_kernel_; }
-  bool bf16_trunk() const { return bf16_kernel_ != Bf16Kernel::none; }
+  // Whether trunk layers 2.. and the heads run in bfloat16 (else all in float32).
+  bool bf16_network() const { return bf16_kernel_ != Bf16Kernel::none; }
   int channels() const { return channels_; }
   int n_freq() const { return n_freq_; }
   int n_frames() const { return n_frames_; }
