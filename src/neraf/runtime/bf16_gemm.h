@@ -1,6 +1,7 @@
 #pragma once
-// bfloat16 matrix products for the trunk of models exported in bfloat16: Y = X·Wᵀ with X and W
-// rounded to bfloat16, products accumulated in float32. Two kernels on the same packed layouts:
+// bfloat16 matrix products for the trunk and heads of models exported in bfloat16: Y = X·Wᵀ with X
+// and W rounded to bfloat16, products accumulated in float32. Two kernels on the same packed
+// layouts:
 //   amx     Intel AMX tiles (TDPBF16PS; Sapphire Rapids and later), ~15× the float32 throughput
 //           of AVX-512 FMA on one core;
 //   avx512  AVX512-BF16 (VDPBF16PS; Cooper Lake, AMD Zen 4 and later), a pair of products per

@@ -52,9 +52,9 @@ class Workspace;
 class Engine {
  public:
   // Validates `m` (check_model_data: throws ModelFileError) and prepares the folded layers, the
-  // time table and the Griffin-Lim plans. allow_bf16: run a bf16 model's trunk in bfloat16 where
-  // the CPU can (see above; best_bf16_kernel); false: float32 always. Throws std::bad_alloc when
-  // out of memory.
+  // time table and the Griffin-Lim plans. allow_bf16: run a bf16 model's trunk and heads in
+  // bfloat16 where the CPU can (see above; best_bf16_kernel); false: float32 always. Throws
+  // std::bad_alloc when out of memory.
   explicit Engine(const ModelData& m, const std::string& name = "model", bool allow_bf16 = true);
 
   // The kernel of the bfloat16 products (trunk and heads), or none when they run in float32.
