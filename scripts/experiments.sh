@@ -31,6 +31,10 @@
 #                                     (default: 0.25 0.5 0.75; "" for none)
 #   E4_VIEWS="10" scripts/...         experiment 4 with these training-view counts only (default:
 #                                     10 20 40)
+#   PROVENANCE=FILE scripts/...       the report's header lists the calls in FILE (Markdown)
+#                                     instead of naming this call alone: for results gathered over
+#                                     several partial calls (docs/results/experiments_provenance.md;
+#                                     add this call to it first)
 # Runs are kept in build/experiments/ and skipped when their eval JSON exists, so an interrupted
 # run continues where it stopped (an unfinished training resumes from its last checkpoint).
 set -euo pipefail
@@ -266,4 +270,5 @@ done
 ELAPSED=$((SECONDS - START))
 echo "experiments: finished in $ELAPSED s" | tee -a "$LOG"
 /usr/bin/python3 scripts/experiments_report.py --out "$OUT" "${REPORT[@]}" --seconds "$ELAPSED" \
-  --command "scripts/experiments.sh$([ "$QUICK" = 1 ] && echo ' --quick')"
+  --command "scripts/experiments.sh$([ "$QUICK" = 1 ] && echo ' --quick')" \
+  ${PROVENANCE:+--provenance "$PROVENANCE"}

@@ -383,11 +383,15 @@ class Report:
         pngs = []
         for m in ["vision", "joint"]:
             e = cells.get(("10", m), {}).get(1)
-            if not e:
-                return
-            run = e.get("run", "")
+            run = e.get("run", "") if e else ""
             found = sorted(glob.glob(os.path.join(run, "eval", "eval_*.png")))
             if not found:
+                # The runs are gone (the report regenerated from the raw JSONs alone): keep the
+                # picture an earlier report drew from them, if there is one.
+                kept = os.path.join(self.args.images, "e4_views.png")
+                if e and os.path.exists(kept):
+                    self.w(f"![sample held-out view]({os.path.relpath(kept, os.path.dirname(self.args.doc))})")
+                    self.w()
                 return
             pngs.append((m, found[0]))
         import matplotlib.image as mpimg
@@ -422,12 +426,21 @@ class Report:
 
     def write(self):
         a = self.args
-        head = ["# Results: the NeRAF paper's experiments on simulated rooms", "",
-                f"Made by `{a.command}` (scripts/experiments.sh, then scripts/experiments_report.py) "
-                f"in {a.seconds / 60:.0f} min on {os.cpu_count()} cores, {machine()}; the raw "
-                f"eval JSONs are in `{os.path.relpath(a.raw, os.path.dirname(a.doc))}/` (one per "
-                "experiment, room and seed; `neraf eval --help` describes their fields). "
-                "Every table is regenerated from them; nothing here is typed in by hand.", "",
+        raw = os.path.relpath(a.raw, os.path.dirname(a.doc))
+        if a.provenance:  # results gathered over several calls: their list, as written down
+            made_by = [f"Made by `scripts/experiments.sh` and `scripts/experiments_report.py`; the "
+                       f"raw eval JSONs are in `{raw}/` (one per experiment, room and seed; "
+                       "`neraf eval --help` describes their fields). Every table is regenerated "
+                       "from them; nothing here is typed in by hand.", "",
+                       open(a.provenance).read().strip()]
+        else:
+            made_by = [f"Made by `{a.command}` (scripts/experiments.sh, then "
+                       f"scripts/experiments_report.py) in {a.seconds / 60:.0f} min on "
+                       f"{os.cpu_count()} cores, {machine()}; the raw eval JSONs are in `{raw}/` "
+                       "(one per experiment, room and seed; `neraf eval --help` describes their "
+                       "fields). Every table is regenerated from them; nothing here is typed in "
+                       "by hand."]
+        head = ["# Results: the NeRAF paper's experiments on simulated rooms", ""] + made_by + ["",
                 "Errors are the published metrics (docs/METRICS.md): mean per-RIR T60 error (%), "
                 "C50 error (dB) and EDT error (s), lower is better. Means over seeds ± standard "
                 "error over seeds.", ""]
@@ -523,6 +536,8 @@ def main():
     p.add_argument("--images")
     p.add_argument("--seconds", type=float, default=0)
     p.add_argument("--command", default="scripts/experiments.sh")
+    p.add_argument("--provenance", help="a Markdown file listing the calls the results come from "
+                   "(docs/results/experiments_provenance.md), shown instead of --command")
     p.add_argument("--subset-views", nargs=3, metavar=("SRC", "DST", "V"))
     a = p.parse_args()
     if a.subset_views:
