@@ -4,6 +4,7 @@
 # split and on new microphone positions, with the nearest and linear baselines.
 #   bench/scale_train.sh [OUT_JSON]      default build/bench/scale_train.json
 #   WORK=build/bench/scale_train SEED=42 NOVEL_EVERY=10 bench/scale_train.sh
+#   TRAIN_ARGS="--grid-features local" ...   extra `neraf train` flags (recorded in the JSON)
 # New positions: `neraf synth --preset apartment --mics random` (500 positions x 4 headings x 14
 # sources = 28,000 RIRs), every NOVEL_EVERY-th of them scored (eval scores every RIR it is given).
 # Steps already done in WORK (data, a finished run with its train.time) are reused. Needs GNU
@@ -15,6 +16,7 @@ WORK=${WORK:-build/bench/scale_train}
 OUT=${1:-build/bench/scale_train.json}
 SEED=${SEED:-42}
 NOVEL_EVERY=${NOVEL_EVERY:-10}
+read -r -a TRAIN_ARGS <<<"${TRAIN_ARGS:-}"
 [ -x /usr/bin/time ] || { echo "bench/scale_train.sh: needs GNU time (apt-get install time)" >&2; exit 1; }
 [ -x "$NERAF" ] || { echo "bench/scale_train.sh: build neraf first (scripts/build.sh)" >&2; exit 1; }
 mkdir -p "$WORK"
@@ -42,7 +44,7 @@ EOF
 
 if [ ! -f "$WORK/train.time" ]; then
   /usr/bin/time -f '%M %e' -o "$WORK/train.time.tmp" \
-    $NERAF train --data "$WORK/apartment" --out "$WORK/run" --seed "$SEED" --force \
+    $NERAF train --data "$WORK/apartment" --out "$WORK/run" --seed "$SEED" --force "${TRAIN_ARGS[@]}" \
     2>&1 | tr '\r' '\n' | grep -v '^train ' >"$WORK/train.log"
   mv "$WORK/train.time.tmp" "$WORK/train.time"
 fi
@@ -50,9 +52,9 @@ fi
   $NERAF eval --run "$WORK/run" --novel-data "$novel" --no-images --json "$WORK/eval.json" --quiet
 
 mkdir -p "$(dirname "$OUT")"
-python3 - "$WORK" "$OUT" "$load_before" "$NOVEL_EVERY" <<'EOF'
+python3 - "$WORK" "$OUT" "$load_before" "$NOVEL_EVERY" "${TRAIN_ARGS[*]}" <<'EOF'
 import datetime, json, os, re, sys
-work, out, load_before, every = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
+work, out, load_before, every, train_args = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4]), sys.argv[5]
 def timed(name):
     kb, s = open(os.path.join(work, name)).read().split()
     return {"peak_rss_mib": round(int(kb) / 1024), "seconds": float(s)}
@@ -67,7 +69,8 @@ def strip(a):  # the tables, without per-RIR file names
     return {k: v for k, v in a.items() if k not in ("per_rir_csv", "grid", "data")}
 audio = ev["audio"]
 result = {
-    "command": "bench/scale_train.sh (SEED=%s, NOVEL_EVERY=%d)" % (config["seed"], every),
+    "command": "bench/scale_train.sh (SEED=%s, NOVEL_EVERY=%d%s)" % (
+        config["seed"], every, ", TRAIN_ARGS=\"%s\"" % train_args if train_args else ""),
     "what": "neraf train --data apartment (cpu preset defaults: joint, schedule scaled to the data), "
             "then neraf eval --novel-data (every %d-th RIR of a 28,000-RIR random-position set)" % every,
     "machine": "%s, %d cores, %.0f GiB" % (model, os.cpu_count(),
