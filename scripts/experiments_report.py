@@ -545,6 +545,9 @@ def main():
         return
     if not (a.out and a.doc and a.raw and a.images):
         p.error("--out, --doc, --raw and --images are required")
+    if a.provenance and not os.path.isfile(a.provenance):
+        p.error(f"--provenance {a.provenance}: no such file (docs/results/experiments_provenance.md "
+                "lists the calls of the committed results)")
     r = Report(a)
     for e in (r.experiment1, r.experiment2, r.experiment3, r.experiment4, r.experiment5):
         e()
