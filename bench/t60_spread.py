@@ -26,13 +26,32 @@ import statistics
 import sys
 
 
+def read_rows(path):
+    """{method: {rir_id: (pred T60, measured T60, t60_error_pct)}} of one per-RIR CSV."""
+    try:
+        with (gzip.open(path, "rt") if path.endswith(".gz") else open(path)) as f:
+            methods = {}
+            for r in csv.DictReader(f):
+                methods.setdefault(r["method"], {})[r["rir_id"]] = (
+                    None if r["invalid_t60"] != "0" else
+                    (float(r["t60_pred_s"]), float(r["t60_gt_s"]), float(r["t60_error_pct"])))
+            return methods
+    except (OSError, KeyError, ValueError) as e:
+        sys.exit(f"bench/t60_spread.py: {path}: not a readable per-RIR CSV of neraf eval ({e}); "
+                 "give RUN/eval/audio_per_rir.csv or audio_novel_per_rir.csv")
+
+
 def summarize(path):
-    methods = {}
-    for r in csv.DictReader(gzip.open(path, "rt") if path.endswith(".gz") else open(path)):
-        if r["invalid_t60"] != "0":
-            continue
-        methods.setdefault(r["method"], []).append(
-            (float(r["t60_pred_s"]), float(r["t60_gt_s"]), float(r["t60_error_pct"])))
+    by_method = read_rows(path)
+    if not by_method:
+        sys.exit(f"bench/t60_spread.py: {path}: no rows; give a per-RIR CSV of neraf eval")
+    # The RIRs every method has a T60 for, so that all methods are compared on the same RIRs.
+    common = set.intersection(*(
+        {i for i, v in rows.items() if v is not None} for rows in by_method.values()))
+    if len(common) < 5:
+        sys.exit(f"bench/t60_spread.py: {path}: fewer than 5 RIRs with a T60 from every method")
+    ids = sorted(common)
+    methods = {name: [rows[i] for i in ids] for name, rows in by_method.items()}
     out = {"csv": path}
     gt_mean = None
     for name, rows in methods.items():
@@ -41,6 +60,7 @@ def summarize(path):
         if gt_mean is None:
             gt_mean = statistics.fmean(gt)
             out["n_rirs"] = len(gt)
+            out["n_rirs_left_out_invalid_t60"] = len(set.union(*map(set, by_method.values()))) - len(gt)
             out["measured"] = {"mean_s": gt_mean, "sd_pct_of_mean": 100 * statistics.pstdev(gt) / gt_mean}
             out["oracle_test_mean"] = {
                 "channel_mean_error_pct": 100 * statistics.fmean(abs(gt_mean - g) / g for g in gt)}
