@@ -175,6 +175,7 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
   f.audio_loss = "sc_sll1";
   f.grid_resolution = 16;
   f.grid_features = "both";
+  f.position_max_freq_exp = 3;
   f.no_relative_geometry = true;
   for (Modality m : {Modality::vision, Modality::joint}) {
     const TrainConfig c = resolve("cpu", m, f);
@@ -191,6 +192,7 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
     EXPECT_EQ(c.audio.loss, "sc_sll1");
     EXPECT_EQ(c.audio.grid_resolution, 16);
     EXPECT_EQ(c.audio.grid_features, "both");
+    EXPECT_EQ(c.audio.position_max_freq_exp, 3);
     EXPECT_FALSE(c.audio.relative_geometry);
   }
   // Unset flags keep the preset's values.

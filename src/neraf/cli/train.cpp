@@ -56,6 +56,8 @@ struct TrainArgs {
   CLI::Option* audio_loss_opt = nullptr;
   int64_t grid_resolution = 32;
   CLI::Option* grid_resolution_opt = nullptr;
+  double position_max_freq_exp = 1;
+  CLI::Option* position_max_freq_exp_opt = nullptr;
   CLI::Option* modality_opt = nullptr;
   int keep = 3;
   int64_t save_every = 0;
@@ -191,6 +193,12 @@ void register_train(CLI::App& app) {
                       "S: the acoustic grid's cells per side (default: the preset's, cpu 32, "
                       "paper 128; at least 17, which the scene encoder halves four times)")
           ->transform(whole_number(17, 256));
+  args->position_max_freq_exp_opt =
+      cmd->add_option("--position-max-freq-exp", args->position_max_freq_exp,
+                      "E: the microphone and source position encodings' highest frequency is 2^E "
+                      "cycles across the RIRs' box (default: the preset's; cpu 1, paper and "
+                      "reference 8); a larger room may want more")
+          ->check(real_number(0, 8));
   CLI::Option* fraction =
       cmd->add_option("--audio-fraction", args->audio_fraction,
                       "Few-shot: train the acoustic field on this seeded fraction of the training "
@@ -331,6 +339,8 @@ void register_train(CLI::App& app) {
     if (decay_loss->count()) flags.decay_loss = args->decay_loss;
     if (args->audio_loss_opt->count()) flags.audio_loss = args->audio_loss;
     if (args->grid_resolution_opt->count()) flags.grid_resolution = args->grid_resolution;
+    if (args->position_max_freq_exp_opt->count())
+      flags.position_max_freq_exp = args->position_max_freq_exp;
     flags.no_relative_geometry = args->no_relative_geometry;
     flags.vision_runs = args->vision_run;
     require(args->data.size() <= 1 || args->modality == "audio",
@@ -349,9 +359,10 @@ void register_train(CLI::App& app) {
                 "same order");
 
     if (flags.modality == infer::Modality::vision)
-      for (CLI::Option* o : {grid, grid_features, args->grid_resolution_opt, fraction, audio_start,
-                             decay_loss, args->audio_loss_opt, no_relative, args->max_len_opt,
-                             args->cache_dir_opt, args->cache_precision_opt})
+      for (CLI::Option* o :
+           {grid, grid_features, args->grid_resolution_opt, args->position_max_freq_exp_opt,
+            fraction, audio_start, decay_loss, args->audio_loss_opt, no_relative, args->max_len_opt,
+            args->cache_dir_opt, args->cache_precision_opt})
         require(o->count() == 0, o->get_name() +
                                      ": sets the acoustic field, which --modality vision does "
                                      "not train; drop it (or train --modality joint)");
@@ -398,8 +409,9 @@ void register_train(CLI::App& app) {
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json is "
                                      "used); start a new run with --out to change it");
-      for (CLI::Option* o : {args->cache_dir_opt, args->cache_precision_opt, args->max_len_opt,
-                             args->audio_loss_opt, args->grid_resolution_opt, args->modality_opt})
+      for (CLI::Option* o :
+           {args->cache_dir_opt, args->cache_precision_opt, args->max_len_opt, args->audio_loss_opt,
+            args->grid_resolution_opt, args->position_max_freq_exp_opt, args->modality_opt})
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json records "
                                      "it); start a new run with --out to change it");

@@ -202,21 +202,22 @@ bool published_sizes(const std::string& name);
 
 // What `neraf train` was asked for; an unset optional takes the preset's value for the modality.
 struct TrainFlags {
-  std::string preset = "cpu";                // --preset
-  Modality modality = Modality::joint;       // --modality
-  std::optional<int64_t> steps;              // --steps
-  uint64_t seed = 42;                        // --seed
-  std::optional<int> threads;                // --threads
-  std::optional<int64_t> rays;               // --rays
-  std::optional<nerf::Precision> precision;  // --precision
-  std::string grid = "sampled";              // --grid
-  std::optional<std::string> grid_features;  // --grid-features
-  double audio_fraction = 1.0;               // --audio-fraction
-  std::optional<int64_t> audio_start_step;   // --audio-start-step
-  std::optional<double> decay_loss;          // --decay-loss
-  std::optional<std::string> audio_loss;     // --audio-loss
-  std::optional<int64_t> grid_resolution;    // --grid-resolution
-  bool no_relative_geometry = false;         // --no-relative-geometry
+  std::string preset = "cpu";                   // --preset
+  Modality modality = Modality::joint;          // --modality
+  std::optional<int64_t> steps;                 // --steps
+  uint64_t seed = 42;                           // --seed
+  std::optional<int> threads;                   // --threads
+  std::optional<int64_t> rays;                  // --rays
+  std::optional<nerf::Precision> precision;     // --precision
+  std::string grid = "sampled";                 // --grid
+  std::optional<std::string> grid_features;     // --grid-features
+  double audio_fraction = 1.0;                  // --audio-fraction
+  std::optional<int64_t> audio_start_step;      // --audio-start-step
+  std::optional<double> decay_loss;             // --decay-loss
+  std::optional<std::string> audio_loss;        // --audio-loss
+  std::optional<int64_t> grid_resolution;       // --grid-resolution
+  std::optional<double> position_max_freq_exp;  // --position-max-freq-exp
+  bool no_relative_geometry = false;            // --no-relative-geometry
   // --vision-run, once per --data (stored as absolute paths); two or more make a multi-scene run.
   std::vector<std::string> vision_runs;
 };
