@@ -88,6 +88,8 @@ bad --audio-fraction "$NERAF" train --data "$FIX" --out "$WORK/run" --audio-frac
 bad --audio-fraction "$NERAF" train --data "$FIX" --out "$WORK/run" --audio-fraction 0
 bad --decay-loss "$NERAF" train --data "$FIX" --out "$WORK/run" --decay-loss inf
 bad --decay-loss "$NERAF" train --data "$FIX" --out "$WORK/run" --decay-loss -1
+bad --position-max-freq-exp "$NERAF" train --data "$FIX" --out "$WORK/run" --position-max-freq-exp nan
+bad --position-max-freq-exp "$NERAF" train --data "$FIX" --out "$WORK/run" --position-max-freq-exp 9
 bad --yaw "$NERAF" render rir --run "$FIX" --mic 1,1,1 --src 2,1,1 --out "$WORK/r.wav" --yaw nan
 bad --yaw "$NERAF" render rir --run "$FIX" --mic 1,1,1 --src 2,1,1 --out "$WORK/r.wav" --yaw 1e6
 bad --src-yaw "$NERAF" auralize --run "$FIX" --mic 1,1,1 --src 2,1,1 --in "$DRY" \

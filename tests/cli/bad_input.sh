@@ -475,6 +475,8 @@ bad "--decay-loss" "$NERAF" train --data "$BASE/ss" --modality vision --decay-lo
   --steps 2 --quiet
 bad "--grid-resolution" "$NERAF" train --data "$BASE/ss" --grid none --grid-resolution 64 \
   --out @OUT@ --steps 2 --quiet
+bad "--position-max-freq-exp" "$NERAF" train --data "$BASE/ss" --modality vision \
+  --position-max-freq-exp 3 --out @OUT@ --steps 2 --quiet
 bad "--grid-features" "$NERAF" train --data "$BASE/ss" --grid none --grid-features local \
   --out @OUT@ --steps 2 --quiet
 bad "--grid-features" "$NERAF" train --data "$BASE/ss" --modality vision --grid-features both \

@@ -229,6 +229,7 @@ TEST(AudioEval, TrainingDifferenceAllowsOnlyTheAblationKnobs) {
   knobs.audio.grid = "zeros";
   knobs.audio.grid_resolution = 16;
   knobs.audio.relative_geometry = false;
+  knobs.audio.position_max_freq_exp = 3;
   knobs.threads = 3;
   knobs.save_every = 7;
   knobs.audio.cache_dir = "/elsewhere";

@@ -132,6 +132,7 @@ nlohmann::json score_audio(const infer::AudioField& run, const std::vector<Ablat
       abl[a.label]["grid_resolution"] = a.run.run().config.audio.grid_resolution;
       abl[a.label]["relative_geometry"] = a.run.run().config.audio.relative_geometry;
       abl[a.label]["loss"] = a.run.run().config.audio.loss;
+      abl[a.label]["position_max_freq_exp"] = a.run.run().config.audio.position_max_freq_exp;
       abl[a.label]["post_processing"] = m.post_processing;
       labels.push_back(a.label);
       e.methods.push_back(std::move(m));
@@ -463,9 +464,10 @@ nlohmann::json evaluate_vision_json(infer::LoadedRun& run, const EvalArgs& args,
   opts.progress = !args.quiet;
   if (!args.no_images) opts.image_dir = dir.written;
   const eval::VisionEval e = eval::evaluate_vision(run.model, images.eval, opts);
-  std::printf("vision: PSNR %.3f dB  SSIM %.4f  over %lld eval views (%.1f s)%s%s\n", e.psnr,
-              e.ssim, static_cast<long long>(e.n_views), e.seconds,
-              opts.image_dir.empty() ? "" : "; GT|prediction images in ", dir.shown.c_str());
+  const std::string images_line =
+      opts.image_dir.empty() ? "" : "; GT|prediction images in " + dir.shown;
+  std::printf("vision: PSNR %.3f dB  SSIM %.4f  over %lld eval views (%.1f s)%s\n", e.psnr, e.ssim,
+              static_cast<long long>(e.n_views), e.seconds, images_line.c_str());
   return eval::to_json(e);
 }
 
@@ -490,8 +492,9 @@ void register_eval(CLI::App& app) {
       "the energy calibration and early/late balance fitted on its training RIRs, and\n"
       "\"neraf_uncalibrated\" without, as the linear baseline is rendered (each row states its\n"
       "post-processing). --ablation-runs must have trained exactly as --run but for audio.grid,\n"
-      "audio.grid_features, audio.grid_resolution, audio.relative_geometry or audio.loss (same\n"
-      "modality, preset, steps, seed, data; else refused). Baselines:\n"
+      "audio.grid_features, audio.grid_resolution, audio.relative_geometry, audio.loss or\n"
+      "audio.position_max_freq_exp (same modality, preset, steps, seed, data; else refused).\n"
+      "Baselines:\n"
       "nearest = the measured RIR of the closest training mic with the same heading and source;\n"
       "linear = inverse-distance blend of the 2-4 closest such training RIRs' magnitudes +\n"
       "Griffin-Lim. griffin_lim_floor is not a method: the test RIR's own measured magnitudes\n"
@@ -551,7 +554,8 @@ void register_eval(CLI::App& app) {
       ->check(CLI::IsMember({"fp32", "fp16"}));
   cmd->add_option("--ablation-runs", args->ablation_runs,
                   "Audio: comma-separated run folders trained exactly as --run but for the "
-                  "ablated option (--grid none / zeros, --no-relative-geometry; same modality, "
+                  "ablated option (--grid, --grid-features, --grid-resolution, --audio-loss, "
+                  "--no-relative-geometry, --position-max-freq-exp; same modality, "
                   "preset, steps, seed and data, else refused), scored on the same test RIRs and "
                   "added to the table and JSON (audio.ablations, labelled by folder name, and "
                   "audio.paired_ablations: --run − each)");

@@ -411,8 +411,12 @@ std::string first_difference(const nlohmann::json& main, const nlohmann::json& o
 }  // namespace
 
 std::vector<std::string> ablation_knobs() {
-  return {"audio.grid", "audio.grid_features", "audio.grid_resolution", "audio.relative_geometry",
-          "audio.loss"};
+  return {"audio.grid",
+          "audio.grid_features",
+          "audio.grid_resolution",
+          "audio.relative_geometry",
+          "audio.loss",
+          "audio.position_max_freq_exp"};
 }
 
 std::string training_difference(const nlohmann::json& main_config, const nlohmann::json& main_data,
