@@ -9,9 +9,10 @@
 //                 (less scatter in the predicted tail);
 // and the nearest and linear baselines, with paired per-RIR differences.
 //
-//   neraf_calibration_variants RUN DATA N_TEST OUT.json
+//   neraf_calibration_variants --run RUN --data DATA --rirs N --json OUT.json
 #include <torch/torch.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -135,13 +136,20 @@ nlohmann::json paired(const eval::AudioMethodEval& a, const eval::AudioMethodEva
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 5) {
-    std::fprintf(stderr, "usage: %s RUN DATA N_TEST OUT.json\n", argv[0]);
-    return 2;
-  }
+  CLI::App app{
+      "Scores a run's acoustic field on its held-out RIRs with other post-processings "
+      "of its predictions (bench/calibration_variants.cpp says which) beside the "
+      "nearest and linear baselines, paired per RIR."};
+  std::string run_dir, data_dir, out_path;
+  int64_t n_test = 1000;
+  app.add_option("--run", run_dir, "Run folder made by neraf train")->required();
+  app.add_option("--data", data_dir, "The run's dataset")->required();
+  app.add_option("--rirs", n_test, "Score the first N held-out RIRs")
+      ->check(CLI::Range(int64_t{1}, int64_t{1} << 40))
+      ->capture_default_str();
+  app.add_option("--json", out_path, "Output JSON file")->required();
+  CLI11_PARSE(app, argc, argv);
   try {
-    const std::string run_dir = argv[1], data_dir = argv[2], out_path = argv[4];
-    const int64_t n_test = std::stoll(argv[3]);
     torch::NoGradGuard no_grad;
     const data::RirSet rirs = data::load_rir_set(data_dir, data::RirLoadOptions{});
     const infer::AudioRun run = infer::load_audio_run(run_dir, torch::kCPU, "",
@@ -179,9 +187,9 @@ int main(int argc, char** argv) {
     for (const eval::AudioMethodEval& m : baselines.methods)
       if (m.name == "nearest" || m.name == "linear") methods.push_back(m);
 
-    nlohmann::json out = {{"command", std::string("neraf_calibration_variants ") + argv[1] + " " +
-                                          argv[2] + " " + argv[3] + " " + argv[4]},
-                          {"n_rirs", test.size()}};
+    std::string command = "neraf_calibration_variants";
+    for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+    nlohmann::json out = {{"command", command}, {"n_rirs", test.size()}};
     for (const eval::AudioMethodEval& m : methods) {
       nlohmann::json j = eval::to_json(m.summary);
       double bias = 0;
