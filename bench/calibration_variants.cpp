@@ -13,8 +13,8 @@
 #include <torch/torch.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "neraf/acoustic/calibration.h"
@@ -23,7 +23,6 @@
 #include "neraf/infer/calibration.h"
 #include "neraf/io/atomic_file.h"
 #include "neraf/metrics/rir_errors.h"
-#include "neraf/util/error.h"
 
 using namespace neraf;
 
