@@ -5,13 +5,14 @@
 #   bench/scale_train.sh [OUT_JSON]      default build/bench/scale_train.json
 #   WORK=build/bench/scale_train SEED=42 NOVEL_EVERY=10 bench/scale_train.sh
 #   TRAIN_ARGS="--grid-features local" ...   extra `neraf train` flags (recorded in the JSON)
+#   NERAF=build/x/neraf ...                  another binary (a copy keeps a rebuild from relinking it mid-run)
 # New positions: `neraf synth --preset apartment --mics random` (500 positions x 4 headings x 14
 # sources = 28,000 RIRs), every NOVEL_EVERY-th of them scored (eval scores every RIR it is given).
 # Steps already done in WORK (data, a finished run with its train.time) are reused. Needs GNU
 # time (Debian package `time`), about 12 GB of disk, and an otherwise idle machine for the timing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-NERAF=build/neraf
+NERAF=${NERAF:-build/neraf}
 WORK=${WORK:-build/bench/scale_train}
 OUT=${1:-build/bench/scale_train.json}
 SEED=${SEED:-42}

@@ -246,5 +246,60 @@ TEST(Nacf, Bf16TrunkTracksFp32) {
   }
 }
 
+// The decay heads' output against the formula computed by hand from the weights, its gradients
+// against the chain rule, and τ read from the right column in both input layouts.
+TEST(Nacf, DecayHeadsAddTimeTimesSlope) {
+  const int64_t b = 4, max_len = 30;
+  const auto t = torch::tensor({0, 7, 22, 29}, torch::kInt64);
+  const auto mic = torch::rand({b, 3}, torch::kFloat64);
+  const auto src = torch::rand({b, 3}, torch::kFloat64);
+  const auto rot = torch::rand({b, 3}, torch::kFloat64);
+  const auto tau = t.to(torch::kFloat32) / double(max_len - 1);  // [B]
+  for (const int64_t g : {int64_t{16}, int64_t{0}}) {
+    torch::manual_seed(9);
+    NacfOptions o = nacf_cpu_options(2, 5, g);
+    o.trunk = {12, 12};
+    o.decay_heads = true;
+    Nacf net(o);
+    const auto params = net->named_parameters();
+    const auto w = [&](const std::string& name) { return params[name]; };
+    const auto h = nacf_input(g > 0 ? torch::rand({g}) : torch::Tensor(), t, max_len, mic, src,
+                              rot);  // [B, in]
+    EXPECT_TRUE(torch::equal(h.select(1, o.time_input_column()), tau)) << "G = " << g;
+    // The trunk by hand, then each channel's level and slope.
+    auto x = h;
+    for (const std::string i : {"0", "1"}) {
+      const std::string l = "soundfield." + i;
+      x = torch::leaky_relu(torch::matmul(x, w(l + ".weight").t()) + w(l + ".bias"), 0.1);
+    }
+    std::vector<torch::Tensor> z;
+    for (const std::string c : {"0", "1"}) {
+      const std::string level = "STFT_linear." + c, slope = "decay_slope." + c;
+      z.push_back(torch::matmul(x, w(level + ".weight").t()) + w(level + ".bias") +
+                  tau.unsqueeze(1) *
+                      (torch::matmul(x, w(slope + ".weight").t()) + w(slope + ".bias")));
+    }
+    const auto pre = torch::stack(z, 1).detach();  // [B, C, F]
+    const auto y = net->forward(h);
+    EXPECT_TRUE(torch::allclose(y, 10.0 * torch::tanh(pre), 1e-5, 1e-5)) << "G = " << g;
+    // d Σy / d slope bias[f] of channel 0 = Σ_b 10·(1 − tanh²(z))·τ_b.
+    y.sum().backward();
+    const auto expected =
+        (10.0 * (1 - torch::tanh(pre.select(1, 0)).pow(2)) * tau.unsqueeze(1)).sum(0);  // [F]
+    EXPECT_TRUE(torch::allclose(w("decay_slope.0.bias").grad(), expected, 1e-4, 1e-5))
+        << "G = " << g;
+    // At τ = 0 the slope heads get no gradient from that row: the first query alone.
+    net->zero_grad();
+    net->forward(h.slice(0, 0, 1)).sum().backward();
+    EXPECT_EQ(w("decay_slope.0.bias").grad().abs().max().item<float>(), 0.0f);
+  }
+  // Off (every preset): no slope heads, the reference's parameters only.
+  Nacf plain(nacf_cpu_options(2, 5, 16));
+  EXPECT_FALSE(plain->named_parameters().contains("decay_slope.0.bias"));
+  NacfOptions on = nacf_cpu_options(2, 5, 16);
+  on.decay_heads = true;
+  EXPECT_EQ(Nacf(on)->head_parameter_count(), 2 * plain->head_parameter_count());
+}
+
 }  // namespace
 }  // namespace neraf::acoustic

@@ -477,8 +477,14 @@ bad "--grid-resolution" "$NERAF" train --data "$BASE/ss" --grid none --grid-reso
   --out @OUT@ --steps 2 --quiet
 bad "--position-max-freq-exp" "$NERAF" train --data "$BASE/ss" --modality vision \
   --position-max-freq-exp 3 --out @OUT@ --steps 2 --quiet
+bad "--decay-heads" "$NERAF" train --data "$BASE/ss" --modality vision --decay-heads \
+  --out @OUT@ --steps 2 --quiet
 bad "--grid-features" "$NERAF" train --data "$BASE/ss" --grid none --grid-features local \
   --out @OUT@ --steps 2 --quiet
+# A run whose acoustic field has decay heads, which the runtime does not evaluate.
+quiet "$NERAF" train --data "$BASE/ss" --out "$TMP/decay_run" --steps 2 --audio-start-step 0 \
+  --rays 128 --decay-heads --quiet
+bad "--decay-heads" "$NERAF" export --run "$TMP/decay_run" --out @OUT@.nrf
 bad "--grid-features" "$NERAF" train --data "$BASE/ss" --modality vision --grid-features both \
   --out @OUT@ --steps 2 --quiet
 # P12 the run's own dataset as "new positions".

@@ -176,6 +176,7 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
   f.grid_resolution = 16;
   f.grid_features = "both";
   f.position_max_freq_exp = 3;
+  f.decay_heads = true;
   f.no_relative_geometry = true;
   for (Modality m : {Modality::vision, Modality::joint}) {
     const TrainConfig c = resolve("cpu", m, f);
@@ -193,6 +194,7 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
     EXPECT_EQ(c.audio.grid_resolution, 16);
     EXPECT_EQ(c.audio.grid_features, "both");
     EXPECT_EQ(c.audio.position_max_freq_exp, 3);
+    EXPECT_TRUE(c.audio.decay_heads);
     EXPECT_FALSE(c.audio.relative_geometry);
   }
   // Unset flags keep the preset's values.
@@ -206,6 +208,7 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
   EXPECT_EQ(cpu.audio.loss, "sc_slmse");
   EXPECT_EQ(cpu.audio.grid_resolution, 32);
   EXPECT_EQ(cpu.audio.grid_features, "global");  // the published design
+  EXPECT_FALSE(cpu.audio.decay_heads);
   EXPECT_EQ(resolve("paper", Modality::joint).audio.grid_resolution, 128);
   EXPECT_EQ(resolve("paper", Modality::joint).seed, 42u);
 }
@@ -372,6 +375,16 @@ TEST(TrainConfig, PerQueryGridFeaturesNeedAGridAndRoundTrip) {
   nlohmann::json j = to_json(train_preset("cpu"));
   j["audio"].erase("grid_features");
   EXPECT_EQ(train_config_from_json(j, "config.json").audio.grid_features, "global");
+}
+
+TEST(TrainConfig, DecayHeadsRoundTripAndDefaultOff) {
+  TrainConfig c = train_preset("cpu");
+  c.audio.decay_heads = true;
+  EXPECT_TRUE(train_config_from_json(to_json(c), "config.json").audio.decay_heads);
+  // A config.json written before the key existed has none.
+  nlohmann::json j = to_json(train_preset("cpu"));
+  j["audio"].erase("decay_heads");
+  EXPECT_FALSE(train_config_from_json(j, "config.json").audio.decay_heads);
 }
 
 // A config.json edited to a million threads is refused as the flag is (4 x the cores at most).

@@ -164,6 +164,11 @@ NacfImpl::NacfImpl(NacfOptions options) : options_(std::move(options)) {
   for (int64_t c = 0; c < options_.n_channels; ++c) {
     STFT_linear->push_back(nn::Linear(in, options_.n_freq));
   }
+  if (options_.decay_heads) {
+    decay_slope = register_module("decay_slope", nn::ModuleList());
+    for (int64_t c = 0; c < options_.n_channels; ++c)
+      decay_slope->push_back(nn::Linear(in, options_.n_freq));
+  }
 }
 
 torch::Tensor NacfImpl::forward(const torch::Tensor& h_in) const {
@@ -184,7 +189,14 @@ torch::Tensor NacfImpl::forward(const torch::Tensor& h_in) const {
   std::vector<torch::Tensor> outs;
   outs.reserve(options_.n_channels);
   for (const auto& m : *STFT_linear) outs.push_back(m->as<nn::Linear>()->forward(h));  // [B, F]
-  return torch::tanh(torch::stack(outs, 1)) * options_.output_scale;                   // [B, C, F]
+  auto out = torch::stack(outs, 1);                                                    // [B, C, F]
+  if (options_.decay_heads) {
+    outs.clear();
+    for (const auto& m : *decay_slope) outs.push_back(m->as<nn::Linear>()->forward(h));  // [B, F]
+    const auto tau = h_in.select(1, options_.time_input_column()).to(torch::kFloat32);   // [B]
+    out = out + tau.view({-1, 1, 1}) * torch::stack(outs, 1);
+  }
+  return torch::tanh(out) * options_.output_scale;
 }
 
 int64_t NacfImpl::trunk_parameter_count() const {
@@ -196,6 +208,8 @@ int64_t NacfImpl::trunk_parameter_count() const {
 int64_t NacfImpl::head_parameter_count() const {
   int64_t n = 0;
   for (const auto& p : STFT_linear->parameters()) n += p.numel();
+  if (decay_slope)
+    for (const auto& p : decay_slope->parameters()) n += p.numel();
   return n;
 }
 

@@ -32,6 +32,12 @@
 // Precision: with `bf16` the trunk's matrix products run in bfloat16 (inputs and weights cast per
 // call, fp32 master weights, fp32 gradients), activations between trunk layers stay bf16; the heads
 // stay fp32 (0.6 % of the FLOPs) so the output is not rounded to bf16's 8-bit mantissa.
+//
+// Decay heads (ours, `--decay-heads`; off in every preset, docs/BENCHMARKS.md): each channel gains
+// a second head, a slope per bin, and out = output_scale·tanh(level + τ·slope) with τ = t/(max_len
+// − 1), the raw time input. A reverberant tail is a straight line in log-magnitude whose slope
+// depends on where the query is; a LeakyReLU trunk given t and the position side by side can only
+// piece that product together, the explicit τ·slope term states it.
 #include <torch/nn/module.h>
 #include <torch/nn/modules/container/modulelist.h>
 #include <torch/nn/modules/linear.h>
@@ -74,9 +80,15 @@ struct NacfOptions {
   // and the map from the positions' metres into the radiance field's frame that reads them.
   int64_t local_features = 0;
   WorldToField world_to_field = kIdentityWorldToField;
+  bool decay_heads = false;  // a slope head per channel beside each level head (above)
 
   std::array<double, 3> extent_m() const {
     return {box_max[0] - box_min[0], box_max[1] - box_min[1], box_max[2] - box_min[2]};
+  }
+  // Where the input holds τ = t/(max_len − 1), the time encoding's raw input (its last column):
+  // after the grid feature, or after mic and source in the no-grid layout (nacf_input).
+  int64_t time_input_column() const {
+    return (grid_features > 0 ? grid_features : 2 * kPositionEncodingDim) + kTimeEncodingDim - 1;
   }
   int64_t in_features() const {
     return grid_features + kPoseEncodingDim + (relative_geometry ? kRelativeGeometryDim : 0) +
@@ -150,6 +162,7 @@ class NacfImpl : public torch::nn::Module {
   // Named like the reference (`soundfield.{0..4}`, `STFT_linear.{c}`) for checkpoint import.
   torch::nn::ModuleList soundfield{nullptr};
   torch::nn::ModuleList STFT_linear{nullptr};  // NOLINT(readability-identifier-naming)
+  torch::nn::ModuleList decay_slope{nullptr};  // one Linear(W→F) per channel; decay_heads only
 };
 TORCH_MODULE(Nacf);
 

@@ -133,6 +133,7 @@ nlohmann::json score_audio(const infer::AudioField& run, const std::vector<Ablat
       abl[a.label]["relative_geometry"] = a.run.run().config.audio.relative_geometry;
       abl[a.label]["loss"] = a.run.run().config.audio.loss;
       abl[a.label]["position_max_freq_exp"] = a.run.run().config.audio.position_max_freq_exp;
+      abl[a.label]["decay_heads"] = a.run.run().config.audio.decay_heads;
       abl[a.label]["post_processing"] = m.post_processing;
       labels.push_back(a.label);
       e.methods.push_back(std::move(m));
@@ -492,8 +493,9 @@ void register_eval(CLI::App& app) {
       "the energy calibration and early/late balance fitted on its training RIRs, and\n"
       "\"neraf_uncalibrated\" without, as the linear baseline is rendered (each row states its\n"
       "post-processing). --ablation-runs must have trained exactly as --run but for audio.grid,\n"
-      "audio.grid_features, audio.grid_resolution, audio.relative_geometry, audio.loss or\n"
-      "audio.position_max_freq_exp (same modality, preset, steps, seed, data; else refused).\n"
+      "audio.grid_features, audio.grid_resolution, audio.relative_geometry, audio.loss,\n"
+      "audio.position_max_freq_exp or audio.decay_heads (same modality, preset, steps, seed,\n"
+      "data; else refused).\n"
       "Baselines:\n"
       "nearest = the measured RIR of the closest training mic with the same heading and source;\n"
       "linear = inverse-distance blend of the 2-4 closest such training RIRs' magnitudes +\n"

@@ -58,6 +58,8 @@ struct TrainArgs {
   CLI::Option* grid_resolution_opt = nullptr;
   double position_max_freq_exp = 1;
   CLI::Option* position_max_freq_exp_opt = nullptr;
+  bool decay_heads = false;
+  CLI::Option* decay_heads_opt = nullptr;
   CLI::Option* modality_opt = nullptr;
   int keep = 3;
   int64_t save_every = 0;
@@ -233,6 +235,11 @@ void register_train(CLI::App& app) {
       "--no-relative-geometry", args->no_relative_geometry,
       "Give the acoustic field absolute positions only, as the reference does (the cpu "
       "preset also gives it the source's direction and distance relative to the listener)");
+  args->decay_heads_opt = cmd->add_flag(
+      "--decay-heads", args->decay_heads,
+      "Give the acoustic field a decay slope per frequency beside each output level, so a "
+      "tail's decay rate is stated per query (ours, an experiment; runs trained with it cannot "
+      "be exported to the runtime)");
   cmd->add_option("--out", args->out, "Run folder to create (or to resume)")->required();
   cmd->add_flag("--resume", args->resume,
                 "Continue the run in --out from its latest checkpoint (uses its config.json)");
@@ -342,6 +349,7 @@ void register_train(CLI::App& app) {
     if (args->position_max_freq_exp_opt->count())
       flags.position_max_freq_exp = args->position_max_freq_exp;
     flags.no_relative_geometry = args->no_relative_geometry;
+    flags.decay_heads = args->decay_heads;
     flags.vision_runs = args->vision_run;
     require(args->data.size() <= 1 || args->modality == "audio",
             "--data: given " + std::to_string(args->data.size()) +
@@ -359,10 +367,10 @@ void register_train(CLI::App& app) {
                 "same order");
 
     if (flags.modality == infer::Modality::vision)
-      for (CLI::Option* o :
-           {grid, grid_features, args->grid_resolution_opt, args->position_max_freq_exp_opt,
-            fraction, audio_start, decay_loss, args->audio_loss_opt, no_relative, args->max_len_opt,
-            args->cache_dir_opt, args->cache_precision_opt})
+      for (CLI::Option* o : {grid, grid_features, args->grid_resolution_opt,
+                             args->position_max_freq_exp_opt, fraction, audio_start, decay_loss,
+                             args->audio_loss_opt, no_relative, args->decay_heads_opt,
+                             args->max_len_opt, args->cache_dir_opt, args->cache_precision_opt})
         require(o->count() == 0, o->get_name() +
                                      ": sets the acoustic field, which --modality vision does "
                                      "not train; drop it (or train --modality joint)");
@@ -411,7 +419,8 @@ void register_train(CLI::App& app) {
                                      "used); start a new run with --out to change it");
       for (CLI::Option* o :
            {args->cache_dir_opt, args->cache_precision_opt, args->max_len_opt, args->audio_loss_opt,
-            args->grid_resolution_opt, args->position_max_freq_exp_opt, args->modality_opt})
+            args->grid_resolution_opt, args->position_max_freq_exp_opt, args->decay_heads_opt,
+            args->modality_opt})
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json records "
                                      "it); start a new run with --out to change it");

@@ -416,7 +416,8 @@ std::vector<std::string> ablation_knobs() {
           "audio.grid_resolution",
           "audio.relative_geometry",
           "audio.loss",
-          "audio.position_max_freq_exp"};
+          "audio.position_max_freq_exp",
+          "audio.decay_heads"};
 }
 
 std::string training_difference(const nlohmann::json& main_config, const nlohmann::json& main_data,

@@ -132,6 +132,7 @@ acoustic::AcousticModelOptions audio_model_options(const TrainConfig& config, in
   o.nacf.bf16 = config.model.precision == nerf::Precision::bf16;
   o.nacf.relative_geometry = a.relative_geometry;
   o.nacf.position_max_freq_exp = a.position_max_freq_exp;
+  o.nacf.decay_heads = a.decay_heads;
   o.nacf.box_min = {audio_aabb.min.x, audio_aabb.min.y, audio_aabb.min.z};
   o.nacf.box_max = {audio_aabb.max.x, audio_aabb.max.y, audio_aabb.max.z};
   o.nacf.world_to_field = world_to_field;

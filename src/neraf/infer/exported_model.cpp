@@ -67,6 +67,10 @@ rt::ModelData export_model_data(const AudioRun& run, const ExportOptions& option
               acoustic::to_string(mo.grid_features) +
               "; the runtime takes the published design (one scene feature per room) only, so "
               "this run cannot be exported; query it with neraf render / eval --run instead");
+  require(!no.decay_heads,
+          run.run().run_dir +
+              ": trained with --decay-heads, which the runtime does not evaluate, so this run "
+              "cannot be exported; query it with neraf render / eval --run instead");
   rt::ModelData m;
   m.neraf_version = NERAF_VERSION;
   m.layout = info.layout == data::AudioLayout::raf ? 1 : 0;

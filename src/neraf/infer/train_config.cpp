@@ -60,6 +60,7 @@ TrainConfig resolve_train_config(const TrainFlags& f) {
   if (f.audio_loss) cfg.audio.loss = *f.audio_loss;
   if (f.grid_resolution) cfg.audio.grid_resolution = *f.grid_resolution;
   if (f.position_max_freq_exp) cfg.audio.position_max_freq_exp = *f.position_max_freq_exp;
+  if (f.decay_heads) cfg.audio.decay_heads = true;
   cfg.audio.fraction = f.audio_fraction;
   if (f.no_relative_geometry) cfg.audio.relative_geometry = false;
   require(cfg.modality == Modality::audio || f.vision_runs.empty(),

@@ -83,6 +83,9 @@ struct AudioConfig {
   bool relative_geometry = true;
   // Highest frequency exponent of the mic/source position encoding (reference 8).
   double position_max_freq_exp = 8.0;
+  // NAcF's decay heads: a slope per bin beside each level head, out = tanh(level + τ·slope)
+  // (ours, off in every preset; --decay-heads; acoustic/nacf.h).
+  bool decay_heads = false;
   // The grid sampler's 18 viewing directions: "spread" (ours: unit vectors spread over the
   // sphere) or "reference" (the published code's degenerate vectors; acoustic/grid_sampler.h).
   std::string view_directions = "spread";
@@ -124,6 +127,7 @@ struct AudioConfig {
     v("energy_calibration", energy_calibration);
     v("relative_geometry", relative_geometry);
     v("position_max_freq_exp", position_max_freq_exp);
+    v("decay_heads", decay_heads);
     v("view_directions", view_directions);
     v("resnet_batch_norm", resnet_batch_norm);
     v("vision_run", vision_run);
@@ -217,6 +221,7 @@ struct TrainFlags {
   std::optional<std::string> audio_loss;        // --audio-loss
   std::optional<int64_t> grid_resolution;       // --grid-resolution
   std::optional<double> position_max_freq_exp;  // --position-max-freq-exp
+  bool decay_heads = false;                     // --decay-heads
   bool no_relative_geometry = false;            // --no-relative-geometry
   // --vision-run, once per --data (stored as absolute paths); two or more make a multi-scene run.
   std::vector<std::string> vision_runs;
