@@ -31,6 +31,12 @@
 #                                     (default: 0.25 0.5 0.75; "" for none)
 #   E4_VIEWS="10" scripts/...         experiment 4 with these training-view counts only (default:
 #                                     10 20 40)
+#   JOBS=2 scripts/...                two runs at once with half the cores' threads each, instead of
+#                                     one with all of them: ~1.4x the runs per hour on 2 cores
+#                                     (docs/RESULTS.md); the numbers differ from a JOBS=1 call's
+#                                     (another --threads), so let one table come from one JOBS.
+#                                     The vision runs that several runs share train alone, with
+#                                     all cores, whatever JOBS is
 #   PROVENANCE=FILE scripts/...       the report's header lists the calls in FILE (Markdown)
 #                                     instead of naming this call alone: for results gathered over
 #                                     several partial calls (docs/results/experiments_provenance.md;
@@ -41,6 +47,17 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 QUICK=0
 [ "${1:-}" = "--quick" ] && QUICK=1
+JOBS=${JOBS:-1}
+case $JOBS in
+  '' | *[!0-9]* | 0)
+    echo "experiments: JOBS takes a whole number from 1 to the cores ($(nproc)), not '$JOBS'" >&2
+    exit 2
+    ;;
+esac
+if [ "$JOBS" -gt "$(nproc)" ]; then
+  echo "experiments: JOBS=$JOBS is more than the $(nproc) cores; use JOBS=$(nproc) or fewer" >&2
+  exit 2
+fi
 scripts/setup.sh
 if ! /usr/bin/python3 -c 'import matplotlib' 2>/dev/null; then  # plots only; not a build dependency
   SUDO=""
@@ -81,15 +98,53 @@ LOG=$OUT/experiments.log
 NERAF=$PWD/$OUT/neraf
 cp build/neraf "$NERAF.tmp" && mv "$NERAF.tmp" "$NERAF"
 echo "experiments: $(date -u +%FT%TZ) on $(nproc) cores, load $(cut -d' ' -f1-3 /proc/loadavg)," \
-  "experiments: $EXPERIMENTS, seeds: ${SEEDS[*]}, quick=$QUICK" | tee -a "$LOG"
+  "experiments: $EXPERIMENTS, seeds: ${SEEDS[*]}, quick=$QUICK, jobs=$JOBS" | tee -a "$LOG"
 START=$SECONDS
+
+# The job pool (JOBS): spawn FUNCTION ARGS... runs `FUNCTION ARGS` (train, evaluate...) in the
+# background with nproc/JOBS threads once fewer than JOBS jobs run, or, with JOBS=1, at once in the
+# foreground with all cores; drain waits for them all. A failed job stops the others and the script.
+RUNNING=0
+POOL_THREADS=()  # --threads for the neraf call of a job; set in its background shell only
+spawn() {
+  if [ "$JOBS" = 1 ]; then
+    "$@"
+    return
+  fi
+  while [ "$RUNNING" -ge "$JOBS" ]; do reap; done
+  (
+    POOL_THREADS=(--threads $(($(nproc) / JOBS)))
+    "$@"
+  ) &
+  RUNNING=$((RUNNING + 1))
+}
+reap() {
+  local rc=0
+  wait -n || rc=$?
+  RUNNING=$((RUNNING - 1))
+  if [ "$rc" != 0 ]; then
+    echo "experiments: a job failed (exit $rc); stopping the others" >&2
+    exit 1
+  fi
+}
+drain() { while [ "$RUNNING" -gt 0 ]; do reap; done; }
+stop_jobs() {
+  local job
+  for job in $(jobs -p); do
+    pkill -TERM -P "$job" 2>/dev/null || true  # its neraf (an interrupted training resumes later)
+    kill "$job" 2>/dev/null || true
+  done
+}
+trap stop_jobs EXIT
+trap 'exit 130' INT # so that Ctrl-C stops the background jobs too (wait -n returns on a trapped signal)
+trap 'exit 143' TERM
 
 say() { printf '\n== %s\n' "$*" | tee -a "$LOG"; }
 # timed NAME CMD...: runs neraf CMD, logging its wall time
 timed() {
   local name=$1 t0=$SECONDS
   shift
-  "$NERAF" "$@" >>"$LOG" 2>&1 || { echo "experiments: $name failed; see $LOG" >&2; tail -n 5 "$LOG" >&2; exit 1; }
+  "$NERAF" "$@" "${POOL_THREADS[@]}" >>"$LOG" 2>&1 || { echo "experiments: $name failed; see $LOG" >&2; tail -n 5 "$LOG" >&2; exit 1; }
   echo "time $name $((SECONDS - t0)) s" | tee -a "$LOG"
 }
 # room NAME SYNTH_ARGS...: a dataset and, at the same scale, the same room heard at new
@@ -123,6 +178,7 @@ evaluate() {
   [ -f "$json" ] || timed "eval $(basename "$json" .json)" eval --run "$run" --json "$json" --quiet "$@"
 }
 
+# Each experiment spawns its trainings, then (once they are all done) its evaluations.
 for e in $EXPERIMENTS; do
   case $e in
     1)
@@ -134,7 +190,8 @@ for e in $EXPERIMENTS; do
           exit 2
           ;;
       esac
-      for r in ${E1_ROOMS:-ss_demo raf_furnished}; do
+      E1_ROOMS=${E1_ROOMS:-ss_demo raf_furnished}
+      for r in $E1_ROOMS; do
         case $r in
           ss_demo) room ss_demo --preset demo --layout soundspaces ;;
           raf_furnished) room raf_furnished --preset furnished_room ;;
@@ -145,22 +202,33 @@ for e in $EXPERIMENTS; do
         esac
         for s in "${SEEDS[@]}"; do
           a=(--data "$OUT/data/$r" --seed "$s" "${JOINT[@]}")
-          train "e1_${r}_s$s" "${a[@]}"
-          evaluate "e1_${r}_s$s" "e1_${r}_s$s" --novel-data "$OUT/data/${r}_novel" --skip-vision
+          spawn train "e1_${r}_s$s" "${a[@]}"
           # Issue 13 §5: the grid read per query beside the published global feature, trained
           # jointly like the default run (E1_FEATURES=0 leaves them out).
           [ "${E1_FEATURES:-1}" = 1 ] || continue
-          train "e1_${r}_features_local_s$s" "${a[@]}" --grid-features local
-          train "e1_${r}_features_both_s$s" "${a[@]}" --grid-features both
-          evaluate "e1_features_${r}_s$s" "e1_${r}_s$s" --novel-data "$OUT/data/${r}_novel" \
-            --skip-vision --no-baselines \
-            --ablation-runs "$OUT/runs/e1_${r}_features_local_s$s,$OUT/runs/e1_${r}_features_both_s$s"
+          spawn train "e1_${r}_features_local_s$s" "${a[@]}" --grid-features local
+          spawn train "e1_${r}_features_both_s$s" "${a[@]}" --grid-features both
         done
       done
+      drain
+      # e1_evaluate ROOM SEED: both evaluations of one run, one after the other (each writes the
+      # run's eval folder)
+      e1_evaluate() {
+        evaluate "e1_$1_s$2" "e1_$1_s$2" --novel-data "$OUT/data/$1_novel" --skip-vision
+        [ "${E1_FEATURES:-1}" = 1 ] || return 0
+        evaluate "e1_features_$1_s$2" "e1_$1_s$2" --novel-data "$OUT/data/$1_novel" \
+          --skip-vision --no-baselines \
+          --ablation-runs "$OUT/runs/e1_$1_features_local_s$2,$OUT/runs/e1_$1_features_both_s$2"
+      }
+      for r in $E1_ROOMS; do
+        for s in "${SEEDS[@]}"; do spawn e1_evaluate "$r" "$s"; done
+      done
+      drain
       ;;
     2)
       say "2/5 the grid ablation (acoustic field alone on a frozen radiance field)"
-      for r in ${E2_ROOMS:-occluded raf_furnished raf_empty}; do
+      E2_ROOMS=${E2_ROOMS:-occluded raf_furnished raf_empty}
+      for r in $E2_ROOMS; do
         case $r in
           occluded) room occluded --preset occluded ;;
           raf_furnished) room raf_furnished --preset furnished_room ;;
@@ -171,23 +239,32 @@ for e in $EXPERIMENTS; do
             ;;
         esac
         train "v_$r" --data "$OUT/data/$r" --modality vision --seed 1 "${VISION[@]}"
+      done
+      for r in $E2_ROOMS; do
         for s in "${SEEDS[@]}"; do
           a=(--data "$OUT/data/$r" --modality audio --vision-run "$OUT/runs/v_$r" --seed "$s"
             "${AUDIO[@]}")
-          train "e2_${r}_full_s$s" "${a[@]}"
-          train "e2_${r}_grid_none_s$s" "${a[@]}" --grid none
-          train "e2_${r}_grid_zeros_s$s" "${a[@]}" --grid zeros
-          train "e2_${r}_S24_s$s" "${a[@]}" --grid-resolution 24
-          train "e2_${r}_S64_s$s" "${a[@]}" --grid-resolution 64
-          train "e2_${r}_features_local_s$s" "${a[@]}" --grid-features local
-          train "e2_${r}_features_both_s$s" "${a[@]}" --grid-features both
+          # S = 64 first: it takes 3-4x as long as the others, which then fill the other job slots
+          spawn train "e2_${r}_S64_s$s" "${a[@]}" --grid-resolution 64
+          spawn train "e2_${r}_full_s$s" "${a[@]}"
+          spawn train "e2_${r}_grid_none_s$s" "${a[@]}" --grid none
+          spawn train "e2_${r}_grid_zeros_s$s" "${a[@]}" --grid zeros
+          spawn train "e2_${r}_S24_s$s" "${a[@]}" --grid-resolution 24
+          spawn train "e2_${r}_features_local_s$s" "${a[@]}" --grid-features local
+          spawn train "e2_${r}_features_both_s$s" "${a[@]}" --grid-features both
+        done
+      done
+      drain
+      for r in $E2_ROOMS; do
+        for s in "${SEEDS[@]}"; do
           abl=$OUT/runs/e2_${r}_grid_none_s$s,$OUT/runs/e2_${r}_grid_zeros_s$s
           abl+=,$OUT/runs/e2_${r}_S24_s$s,$OUT/runs/e2_${r}_S64_s$s
           abl+=,$OUT/runs/e2_${r}_features_local_s$s,$OUT/runs/e2_${r}_features_both_s$s
-          evaluate "e2_${r}_s$s" "e2_${r}_full_s$s" --novel-data "$OUT/data/${r}_novel" \
+          spawn evaluate "e2_${r}_s$s" "e2_${r}_full_s$s" --novel-data "$OUT/data/${r}_novel" \
             --skip-vision --ablation-runs "$abl"
         done
       done
+      drain
       ;;
     3)
       say "3/5 few-shot (25 / 50 / 75 / 100 % of the training RIRs)"
@@ -200,6 +277,9 @@ for e in $EXPERIMENTS; do
             ;;
         esac
       done
+      # with_features F: whether the per-query variants (issue 13 §5) run at fraction F (100 % is
+      # experiment 2's furnished-room table)
+      with_features() { case " ${E3_FEATURES-0.25 0.5 0.75} " in *" $1 "*) return 0 ;; esac; return 1; }
       room raf_furnished --preset furnished_room
       train v_raf_furnished --data "$OUT/data/raf_furnished" --modality vision --seed 1 "${VISION[@]}"
       for s in "${SEEDS[@]}"; do
@@ -209,23 +289,35 @@ for e in $EXPERIMENTS; do
           a=(--data "$OUT/data/raf_furnished" --modality audio --vision-run "$OUT/runs/v_raf_furnished"
             --seed "$s" --audio-fraction "$f" "${AUDIO[@]}")
           # A scored run is not trained again (its run folder may have been deleted for space).
-          [ -f "$OUT/eval/e3_raf_furnished_f${f}_s$s.json" ] || train "$run" "${a[@]}"
-          evaluate "e3_raf_furnished_f${f}_s$s" "$run" --skip-vision
-          # Issue 13 §5: the grid read per query beside the published global feature, at the
-          # fractions E3_FEATURES takes (100 % is experiment 2's furnished-room table).
-          case " ${E3_FEATURES-0.25 0.5 0.75} " in *" $f "*) ;; *) continue ;; esac
-          train "$run" "${a[@]}"
-          train "e3_raf_furnished_features_local_f${f}_s$s" "${a[@]}" --grid-features local
-          train "e3_raf_furnished_features_both_f${f}_s$s" "${a[@]}" --grid-features both
-          evaluate "e3_features_raf_furnished_f${f}_s$s" "$run" --skip-vision --no-baselines \
-            --ablation-runs "$OUT/runs/e3_raf_furnished_features_local_f${f}_s$s,$OUT/runs/e3_raf_furnished_features_both_f${f}_s$s"
+          if [ ! -f "$OUT/eval/e3_raf_furnished_f${f}_s$s.json" ] || with_features "$f"; then
+            spawn train "$run" "${a[@]}"
+          fi
+          with_features "$f" || continue
+          spawn train "e3_raf_furnished_features_local_f${f}_s$s" "${a[@]}" --grid-features local
+          spawn train "e3_raf_furnished_features_both_f${f}_s$s" "${a[@]}" --grid-features both
         done
       done
+      drain
+      # e3_evaluate FRACTION SEED: both evaluations of one run, one after the other (each writes
+      # the run's eval folder)
+      e3_evaluate() {
+        local run=e3_raf_furnished_f$1_s$2
+        [ "$1" = 1 ] && run=e2_raf_furnished_full_s$2
+        evaluate "e3_raf_furnished_f$1_s$2" "$run" --skip-vision
+        with_features "$1" || return 0
+        evaluate "e3_features_raf_furnished_f$1_s$2" "$run" --skip-vision --no-baselines \
+          --ablation-runs "$OUT/runs/e3_raf_furnished_features_local_f$1_s$2,$OUT/runs/e3_raf_furnished_features_both_f$1_s$2"
+      }
+      for s in "${SEEDS[@]}"; do
+        for f in 0.25 0.5 0.75 1; do spawn e3_evaluate "$f" "$s"; done
+      done
+      drain
       ;;
     4)
       say "4/5 cross-modal vision with sparse images (10 / 20 / 40 training views)"
       room ss_demo --preset demo --layout soundspaces
-      for v in ${E4_VIEWS:-10 20 40}; do
+      E4_VIEWS=${E4_VIEWS:-10 20 40}
+      for v in $E4_VIEWS; do
         case $v in
           10 | 20 | 40) ;;
           *)
@@ -239,12 +331,18 @@ for e in $EXPERIMENTS; do
           /usr/bin/python3 scripts/experiments_report.py --subset-views "$OUT/data/ss_demo" "$d" "$v"
         fi
         for s in "${SEEDS[@]}"; do
-          train "e4_views${v}_vision_s$s" --data "$d" --modality vision --seed "$s" "${VIEWS_VISION[@]}"
-          train "e4_views${v}_joint_s$s" --data "$d" --seed "$s" "${VIEWS_JOINT[@]}"
-          evaluate "e4_views${v}_vision_s$s" "e4_views${v}_vision_s$s" --no-baselines
-          evaluate "e4_views${v}_joint_s$s" "e4_views${v}_joint_s$s" --no-baselines
+          spawn train "e4_views${v}_vision_s$s" --data "$d" --modality vision --seed "$s" "${VIEWS_VISION[@]}"
+          spawn train "e4_views${v}_joint_s$s" --data "$d" --seed "$s" "${VIEWS_JOINT[@]}"
         done
       done
+      drain
+      for v in $E4_VIEWS; do
+        for s in "${SEEDS[@]}"; do
+          spawn evaluate "e4_views${v}_vision_s$s" "e4_views${v}_vision_s$s" --no-baselines
+          spawn evaluate "e4_views${v}_joint_s$s" "e4_views${v}_joint_s$s" --no-baselines
+        done
+      done
+      drain
       ;;
     5)
       say "5/5 the loss study (SC+SL-MSE, the reference's, vs SC+SL-L1 vs MSE)"
@@ -253,12 +351,16 @@ for e in $EXPERIMENTS; do
       for s in "${SEEDS[@]}"; do
         a=(--data "$OUT/data/raf_furnished" --modality audio --vision-run "$OUT/runs/v_raf_furnished"
           --seed "$s" "${AUDIO[@]}")
-        train "e2_raf_furnished_full_s$s" "${a[@]}"
-        train "e5_raf_furnished_loss_sc_sll1_s$s" "${a[@]}" --audio-loss sc_sll1
-        train "e5_raf_furnished_loss_mse_s$s" "${a[@]}" --audio-loss mse
-        evaluate "e5_raf_furnished_s$s" "e2_raf_furnished_full_s$s" --skip-vision --no-baselines \
+        spawn train "e2_raf_furnished_full_s$s" "${a[@]}"
+        spawn train "e5_raf_furnished_loss_sc_sll1_s$s" "${a[@]}" --audio-loss sc_sll1
+        spawn train "e5_raf_furnished_loss_mse_s$s" "${a[@]}" --audio-loss mse
+      done
+      drain
+      for s in "${SEEDS[@]}"; do
+        spawn evaluate "e5_raf_furnished_s$s" "e2_raf_furnished_full_s$s" --skip-vision --no-baselines \
           --ablation-runs "$OUT/runs/e5_raf_furnished_loss_sc_sll1_s$s,$OUT/runs/e5_raf_furnished_loss_mse_s$s"
       done
+      drain
       ;;
     *)
       echo "experiments: unknown experiment '$e' (EXPERIMENTS takes 1 to 5)" >&2

@@ -481,13 +481,13 @@ bad "--decay-heads" "$NERAF" train --data "$BASE/ss" --modality vision --decay-h
   --out @OUT@ --steps 2 --quiet
 bad "--grid-features" "$NERAF" train --data "$BASE/ss" --grid none --grid-features local \
   --out @OUT@ --steps 2 --quiet
+bad "--grid-features" "$NERAF" train --data "$BASE/ss" --modality vision --grid-features both \
+  --out @OUT@ --steps 2 --quiet
 # A run whose acoustic field has decay heads, which the runtime does not evaluate.
 quiet "$NERAF" train --data "$BASE/ss" --out "$TMP/decay_run" --steps 2 --audio-start-step 0 \
   --rays 128 --decay-heads --quiet
 rm -rf "$BASE/ss/.neraf_cache"  # as above: later copies of the dataset must not inherit it
 bad "--decay-heads" "$NERAF" export --run "$TMP/decay_run" --out @OUT@.nrf
-bad "--grid-features" "$NERAF" train --data "$BASE/ss" --modality vision --grid-features both \
-  --out @OUT@ --steps 2 --quiet
 # P12 the run's own dataset as "new positions".
 bad "own dataset" "$NERAF" eval --run "$BASE/run" --novel-data "$BASE/ss" --json @OUT@.json \
   --skip-vision --no-baselines --quiet

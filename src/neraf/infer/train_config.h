@@ -83,8 +83,8 @@ struct AudioConfig {
   bool relative_geometry = true;
   // Highest frequency exponent of the mic/source position encoding (reference 8).
   double position_max_freq_exp = 8.0;
-  // NAcF's decay heads: a slope per bin beside each level head, out = tanh(level + τ·slope)
-  // (ours, off in every preset; --decay-heads; acoustic/nacf.h).
+  // NAcF's decay heads: a slope per bin beside each level head, out = output_scale·tanh(level +
+  // τ·slope) (ours, off in every preset; --decay-heads; acoustic/nacf.h).
   bool decay_heads = false;
   // The grid sampler's 18 viewing directions: "spread" (ours: unit vectors spread over the
   // sphere) or "reference" (the published code's degenerate vectors; acoustic/grid_sampler.h).
