@@ -32,8 +32,8 @@
 #   E4_VIEWS="10" scripts/...         experiment 4 with these training-view counts only (default:
 #                                     10 20 40)
 #   JOBS=2 scripts/...                two runs at once with half the cores' threads each, instead of
-#                                     one with all of them: ~1.4x the runs per hour on 2 cores
-#                                     (docs/RESULTS.md); the numbers differ from a JOBS=1 call's
+#                                     one with all of them: 1.3x the runs per hour on 2 cores
+#                                     (bench/experiments_jobs.sh); the numbers differ from a JOBS=1 call's
 #                                     (another --threads), so let one table come from one JOBS.
 #                                     The vision runs that several runs share train alone, with
 #                                     all cores, whatever JOBS is
