@@ -6,6 +6,8 @@
 #include <cmath>
 #include <string>
 
+#include "neraf/nerf/config.h"
+
 namespace neraf::acoustic {
 namespace {
 
@@ -104,7 +106,9 @@ TEST(ResNet3d, CpuVariantShapeAndSize) {
 }
 
 // A bf16 network (the layout benchmark's variant) runs end to end, the max pool included, and its
-// feature stays within bf16 rounding of the fp32 one with the same weights (measured 0.8 %).
+// feature stays within bf16 rounding of the fp32 one with the same weights: measured 0.8 % where
+// the CPU has native bf16 instructions (oneDNN), 9.2 % on a Zen 3 EPYC without them (LibTorch's
+// fallback convolution rounds more).
 TEST(ResNet3d, Bfloat16ForwardMatchesFp32) {
   torch::manual_seed(4);
   ResNet3d net(resnet3d_cpu_options());
@@ -116,7 +120,7 @@ TEST(ResNet3d, Bfloat16ForwardMatchesFp32) {
   const double relative =
       (bf16.to(torch::kFloat32) - fp32).norm().item<double>() / fp32.norm().item<double>();
   EXPECT_GT(relative, 0.0);  // it did run in bf16
-  EXPECT_LT(relative, 0.03);
+  EXPECT_LT(relative, neraf::nerf::cpu_supports_bf16() ? 0.03 : 0.15);
 }
 
 TEST(ResNet3d, EvalEqualsTrainModeOnTheSameGrid) {
