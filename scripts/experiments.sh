@@ -171,11 +171,26 @@ train() {
   touch "$run/done"
 }
 # evaluate JSON RUN ARGS...: neraf eval of $OUT/runs/RUN into $OUT/eval/JSON.json
+# A JSON is kept while it is newer than the `done` marker of every run it scores: a run trained
+# after it is scored again; a deleted run folder does not force a new scoring.
 evaluate() {
   local json=$OUT/eval/$1.json run=$OUT/runs/$2
   shift 2
   mkdir -p "$OUT/eval"
-  [ -f "$json" ] || timed "eval $(basename "$json" .json)" eval --run "$run" --json "$json" --quiet "$@"
+  local scored=("$run") ablations arg prev=
+  for arg in "$@"; do
+    if [ "$prev" = --ablation-runs ]; then
+      IFS=, read -r -a ablations <<<"$arg"
+      scored+=("${ablations[@]}")
+    fi
+    prev=$arg
+  done
+  for arg in "${scored[@]}"; do
+    [ "$json" -nt "$arg/done" ] || {
+      timed "eval $(basename "$json" .json)" eval --run "$run" --json "$json" --quiet "$@"
+      return
+    }
+  done
 }
 
 # Each experiment spawns its trainings, then (once they are all done) its evaluations.

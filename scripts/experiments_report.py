@@ -260,8 +260,7 @@ class Report:
                "segment between them; `both`, that and the global feature); scored together "
                "by `neraf eval --ablation-runs` (which refuses runs that trained differently). "
                "The paper's coarsest size, S = 16, cannot pass the scene encoder (it halves the "
-               "grid four times; BatchNorm would see one voxel), so 24 stands in for it. A room "
-               "whose table lacks the `features` rows was run before they existed.")
+               "grid four times; BatchNorm would see one voxel), so 24 stands in for it.")
         self.w()
         for room, title in rooms:
             evals = relabel(self.load("e2_" + room))
