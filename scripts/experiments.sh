@@ -41,8 +41,10 @@
 #                                     instead of naming this call alone: for results gathered over
 #                                     several partial calls (docs/results/experiments_provenance.md;
 #                                     add this call to it first)
-# Runs are kept in build/experiments/ and skipped when their eval JSON exists, so an interrupted
-# run continues where it stopped (an unfinished training resumes from its last checkpoint).
+# Runs are kept in build/experiments/: a finished run is not trained again, and an eval JSON is
+# kept while it is newer than every run it scores, so an interrupted call continues where it
+# stopped (an unfinished training resumes from its last checkpoint) and a run trained again is
+# scored again.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 QUICK=0
