@@ -14,9 +14,11 @@
 #      --decay-heads --grid zeros, scored against it the same way.
 # Then bench/decay_heads_summary.py gathers the evaluations into RESULT: per room and split the
 # mean over seeds of the paired difference decay − published (± standard error over seeds).
+# TRAIN_ARGS (e.g. "--grid-features local") go to every audio run, so the comparisons above hold
+# with that option on both sides.
 # Quality only (not timing): seeds run PARALLEL at a time with THREADS threads each.
 # Usage: bench/decay_heads.sh   (env: NERAF, WORK, RESULT, SEEDS, AUDIO_STEPS, THREADS, PARALLEL,
-# ROOMS, ZEROS_ROOMS)
+# ROOMS, ZEROS_ROOMS, TRAIN_ARGS)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 NERAF=${NERAF:-build/neraf}
@@ -28,6 +30,7 @@ THREADS=${THREADS:-1}
 PARALLEL=${PARALLEL:-2}
 ROOMS=${ROOMS:-ss_demo occluded raf_furnished}
 ZEROS_ROOMS=${ZEROS_ROOMS-occluded}
+read -r -a TRAIN_ARGS <<<"${TRAIN_ARGS:-}"
 mkdir -p "$WORK"
 LOAD_BEFORE=$(cut -d' ' -f1-3 /proc/loadavg)
 START=$(date -u +%FT%TZ)
@@ -47,7 +50,7 @@ synth_args() {
 seed_runs() {
   local r=$1 s=$2 base=$WORK/$1/base_s$2 decay=$WORK/$1/decay_s$2
   local a=(train --modality audio --data "$WORK/$r/data" --vision-run "$WORK/$r/vision" --seed "$s"
-    --steps "$AUDIO_STEPS" --threads "$THREADS" --force --quiet)
+    --steps "$AUDIO_STEPS" --threads "$THREADS" --force --quiet "${TRAIN_ARGS[@]}")
   [ -f "$base/done" ] || { "$NERAF" "${a[@]}" --out "$base" && touch "$base/done"; }
   [ -f "$decay/done" ] || { "$NERAF" "${a[@]}" --decay-heads --out "$decay" && touch "$decay/done"; }
   # neraf writes the JSON atomically: it exists only once the evaluation is complete.
@@ -92,5 +95,5 @@ done
 CPU=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | xargs)
 /usr/bin/python3 bench/decay_heads_summary.py --work "$WORK" --rooms $ROOMS --seeds $SEEDS \
   --zeros-rooms $ZEROS_ROOMS --machine "$CPU" \
-  --command "bench/decay_heads.sh (SEEDS=\"$SEEDS\" AUDIO_STEPS=$AUDIO_STEPS THREADS=$THREADS PARALLEL=$PARALLEL)" \
+  --command "bench/decay_heads.sh (SEEDS=\"$SEEDS\" AUDIO_STEPS=$AUDIO_STEPS THREADS=$THREADS PARALLEL=$PARALLEL TRAIN_ARGS=\"${TRAIN_ARGS[*]}\")" \
   --start "$START" --load-before "$LOAD_BEFORE" --seconds $((SECONDS - T0)) --out "$RESULT"
