@@ -2,6 +2,8 @@
 // 2048 slices + SC+SLMSE loss), its parts, the Adam step, and render_stft latency for one RIR.
 // Shapes: SoundSpaces (C = 2, F = 257, max_len = 78 frames). Presets cpu (32³ grid, small ResNet,
 // NAcF 5×512) and paper (128³, ResNet3D-50/layer3, NAcF 1187→5096→…→512), fp32 and bf16 NAcF trunk.
+// The steps report their FLOPs (gflop_per_step, gflop_per_s) and BM_PeakSgemm this machine's
+// fastest fp32 rate, so a step's time can be set against the least its arithmetic needs.
 //
 //   build/neraf_bench_acoustic --benchmark_out=build/bench/acoustic.json
 //   build/neraf_bench_acoustic --benchmark_filter=cpu
@@ -12,6 +14,7 @@
 #include <algorithm>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "bench_main.h"
@@ -46,6 +49,77 @@ void set_label(benchmark::State& state, int64_t preset, bool bf16) {
                  " threads=" + std::to_string(torch::get_num_threads()));
 }
 
+// Multiply-adds of one forward pass, for the FLOP counters (issue 14 §4: how close to the
+// machine's limit a step runs). A convolution costs (output voxels) × (weights); the sides follow
+// ResNet3d's layers: the stem (stride 2, padding k/2) and the max pool (k3, s2, p1) give ⌈side/2⌉,
+// a stage's stride sits on a Bottleneck's 3×3×3 conv (its 1×1×1 conv1 runs at the stage's input
+// side) and on a BasicBlock's conv1. Returns {MACs, weights counted}; the caller checks the weights
+// against the real module so that this walk cannot drift from it.
+std::pair<double, int64_t> resnet3d_forward_macs(const ResNet3dOptions& o, int64_t side) {
+  double macs = 0;
+  int64_t weights = 0;
+  auto add = [&](int64_t in, int64_t out, int64_t kernel, int64_t out_side) {
+    const int64_t w = in * out * kernel * kernel * kernel;
+    weights += w;
+    macs += static_cast<double>(w) * static_cast<double>(out_side * out_side * out_side);
+  };
+  auto halve = [](int64_t s, int64_t stride) { return (s + stride - 1) / stride; };
+  side = halve(side, 2);
+  add(o.in_channels, o.stem_channels, o.stem_kernel, side);
+  if (o.stem_max_pool) side = halve(side, 2);
+  int64_t in = o.stem_channels;
+  const int64_t expansion = resnet3d_expansion(o.block);
+  for (size_t s = 0; s < o.layers.size(); ++s) {
+    for (int64_t b = 0; b < o.layers[s]; ++b) {
+      const int64_t stride = b == 0 ? o.strides[s] : 1, planes = o.planes[s];
+      const int64_t out = planes * expansion, in_side = side;
+      side = halve(side, stride);
+      if (o.block == ResBlock::kBottleneck) {
+        add(in, planes, 1, in_side);
+        add(planes, planes, 3, side);
+        add(planes, out, 1, side);
+      } else {
+        add(in, planes, 3, side);
+        add(planes, planes, 3, side);
+      }
+      if (stride != 1 || in != out) add(in, out, 1, side);
+      in = out;
+    }
+  }
+  return {macs, weights};
+}
+
+int64_t conv_weights(torch::nn::Module& m) {
+  int64_t n = 0;
+  for (const auto& sub : m.modules()) {
+    if (const auto* c = sub->as<torch::nn::Conv3d>()) n += c->weight.numel();
+  }
+  return n;
+}
+
+// Multiply-adds of the Linear layers (NAcF's trunk and heads) for `batch` queries.
+double linear_forward_macs(torch::nn::Module& m, int64_t batch) {
+  double macs = 0;
+  for (const auto& sub : m.modules()) {
+    if (const auto* l = sub->as<torch::nn::Linear>()) {
+      macs += static_cast<double>(l->weight.numel()) * static_cast<double>(batch);
+    }
+  }
+  return macs;
+}
+
+// A training step's FLOPs: forward 2 × MACs, backward twice that (the gradients of the inputs and
+// of the weights of every layer; the grid needs its gradient, as in joint training), so 6 × MACs,
+// less 2 × `untracked_input_macs` for a first layer whose input needs no gradient. Element-wise
+// work (batch norm, activations, the loss) is left out: a lower bound.
+void set_flop_counters(benchmark::State& state, double forward_macs,
+                       double untracked_input_macs = 0) {
+  const double flops = 6.0 * forward_macs - 2.0 * untracked_input_macs;
+  state.counters["gflop_per_step"] = flops / 1e9;
+  state.counters["gflop_per_s"] =
+      benchmark::Counter(flops / 1e9, benchmark::Counter::kIsIterationInvariantRate);
+}
+
 // Full step without the optimiser: grid (requires grad, as the fresh cells do) → ResNet3D →
 // NAcF on 2048 slices → loss → backward.
 void BM_AcousticStep(benchmark::State& state) {
@@ -64,6 +138,9 @@ void BM_AcousticStep(benchmark::State& state) {
     loss.total.backward();
     benchmark::DoNotOptimize(loss.total.item<float>());
   }
+  const auto [resnet_macs, weights] = resnet3d_forward_macs(m->options().resnet, s);
+  state.counters["conv_weights_match"] = weights == conv_weights(*m) ? 1 : 0;
+  set_flop_counters(state, resnet_macs + linear_forward_macs(*m, kBatch));
   set_label(state, preset, bf16);
 }
 
@@ -81,6 +158,9 @@ void BM_ResNet3dFwdBwd(benchmark::State& state) {
     y.sum().backward();
     benchmark::DoNotOptimize(y.data_ptr());
   }
+  const auto [macs, weights] = resnet3d_forward_macs(o.resnet, s);
+  state.counters["conv_weights_match"] = weights == conv_weights(*net) ? 1 : 0;
+  set_flop_counters(state, macs);
   set_label(state, preset, false);
 }
 
@@ -177,7 +257,34 @@ void BM_NacfFwdBwd(benchmark::State& state) {
     loss.total.backward();
     benchmark::DoNotOptimize(loss.total.item<float>());
   }
+  // NAcF's input here is a constant (no ResNet3D in front), so the input gradient of its first
+  // layer (the first Linear registered: soundfield.0) is never computed.
+  double first_layer_macs = 0;
+  for (const auto& sub : net->modules()) {
+    if (const auto* l = sub->as<torch::nn::Linear>()) {
+      first_layer_macs = static_cast<double>(l->weight.numel()) * kBatch;
+      break;
+    }
+  }
+  set_flop_counters(state, linear_forward_macs(*net, kBatch), first_layer_macs);
   set_label(state, preset, bf16);
+}
+
+// The fastest fp32 arithmetic this machine gives LibTorch: one large square matrix product
+// (OpenBLAS sgemm), N = range(0). The FLOP counters of the steps above divided by this rate bound
+// their time from below: a convolution or an MLP layer is at best a matrix product of its size.
+void BM_PeakSgemm(benchmark::State& state) {
+  const int64_t n = state.range(0);
+  torch::manual_seed(0);
+  const auto a = torch::randn({n, n}), b = torch::randn({n, n});
+  auto c = torch::empty({n, n});
+  for (auto _ : state) {
+    torch::mm_out(c, a, b);
+    benchmark::DoNotOptimize(c.data_ptr());
+  }
+  state.counters["gflop_per_s"] =
+      benchmark::Counter(2.0 * n * n * n / 1e9, benchmark::Counter::kIsIterationInvariantRate);
+  state.SetLabel("fp32 threads=" + std::to_string(torch::get_num_threads()));
 }
 
 void BM_AdamStep(benchmark::State& state) {
@@ -241,6 +348,12 @@ void BM_RenderStftCachedFeature(benchmark::State& state) {
       ->Iterations(1)                 \
       ->Repetitions(3)
 
+BENCHMARK(BM_PeakSgemm)
+    ->Arg(1024)
+    ->Arg(2048)
+    ->Arg(4096)
+    ->Unit(benchmark::kMillisecond)
+    ->Repetitions(5);
 NERAF_CPU(BM_AcousticStep, 0);
 NERAF_CPU(BM_AcousticStep, 1);
 NERAF_CPU(BM_ResNet3dFwdBwd, 0);
