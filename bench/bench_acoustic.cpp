@@ -12,6 +12,7 @@
 #include <torch/torch.h>
 
 #include <algorithm>
+#include <numeric>
 #include <string>
 #include <thread>
 #include <utility>
@@ -89,23 +90,18 @@ std::pair<double, int64_t> resnet3d_forward_macs(const ResNet3dOptions& o, int64
   return {macs, weights};
 }
 
-int64_t conv_weights(torch::nn::Module& m) {
-  int64_t n = 0;
+// The weight count of each submodule of type Layer (Conv3d, Linear), in registration order.
+template <typename Layer>
+std::vector<int64_t> weight_counts(torch::nn::Module& m) {
+  std::vector<int64_t> counts;
   for (const auto& sub : m.modules()) {
-    if (const auto* c = sub->as<torch::nn::Conv3d>()) n += c->weight.numel();
+    if (const auto* layer = sub->as<Layer>()) counts.push_back(layer->weight.numel());
   }
-  return n;
+  return counts;
 }
 
-// Multiply-adds of the Linear layers (NAcF's trunk and heads) for `batch` queries.
-double linear_forward_macs(torch::nn::Module& m, int64_t batch) {
-  double macs = 0;
-  for (const auto& sub : m.modules()) {
-    if (const auto* l = sub->as<torch::nn::Linear>()) {
-      macs += static_cast<double>(l->weight.numel()) * static_cast<double>(batch);
-    }
-  }
-  return macs;
+int64_t sum(const std::vector<int64_t>& v) {
+  return std::accumulate(v.begin(), v.end(), int64_t{0});
 }
 
 // A training step's FLOPs: forward 2 × MACs, backward twice that (the gradients of the inputs and
@@ -139,8 +135,10 @@ void BM_AcousticStep(benchmark::State& state) {
     benchmark::DoNotOptimize(loss.total.item<float>());
   }
   const auto [resnet_macs, weights] = resnet3d_forward_macs(m->options().resnet, s);
-  state.counters["conv_weights_match"] = weights == conv_weights(*m) ? 1 : 0;
-  set_flop_counters(state, resnet_macs + linear_forward_macs(*m, kBatch));
+  state.counters["conv_weights_match"] = weights == sum(weight_counts<torch::nn::Conv3d>(*m));
+  // A Linear layer costs its weights × the batch.
+  set_flop_counters(state,
+                    resnet_macs + double(sum(weight_counts<torch::nn::Linear>(*m))) * kBatch);
   set_label(state, preset, bf16);
 }
 
@@ -159,7 +157,7 @@ void BM_ResNet3dFwdBwd(benchmark::State& state) {
     benchmark::DoNotOptimize(y.data_ptr());
   }
   const auto [macs, weights] = resnet3d_forward_macs(o.resnet, s);
-  state.counters["conv_weights_match"] = weights == conv_weights(*net) ? 1 : 0;
+  state.counters["conv_weights_match"] = weights == sum(weight_counts<torch::nn::Conv3d>(*net));
   set_flop_counters(state, macs);
   set_label(state, preset, false);
 }
@@ -259,14 +257,8 @@ void BM_NacfFwdBwd(benchmark::State& state) {
   }
   // NAcF's input here is a constant (no ResNet3D in front), so the input gradient of its first
   // layer (the first Linear registered: soundfield.0) is never computed.
-  double first_layer_macs = 0;
-  for (const auto& sub : net->modules()) {
-    if (const auto* l = sub->as<torch::nn::Linear>()) {
-      first_layer_macs = static_cast<double>(l->weight.numel()) * kBatch;
-      break;
-    }
-  }
-  set_flop_counters(state, linear_forward_macs(*net, kBatch), first_layer_macs);
+  const auto linear = weight_counts<torch::nn::Linear>(*net);
+  set_flop_counters(state, double(sum(linear)) * kBatch, double(linear.front()) * kBatch);
   set_label(state, preset, bf16);
 }
 
