@@ -1,0 +1,33 @@
+#!/bin/bash
+# Where the default neraf loses to the baselines in the RAF-layout furnished room (issue 13), on
+# experiment 2's full-model runs (made by `EXPERIMENTS=2 scripts/experiments.sh`; read, not changed):
+#   1. a larger set of new microphone positions than the experiments' 80 RIRs: 200 random
+#      microphones x 2 sources = 400 RIRs of the same room (neraf synth, seed 4), scored with each
+#      seed's run by `neraf eval --novel-data` (which scores the 60 held-out RIRs again too);
+#   2. scripts/raf_gap.py on the runs' own per-RIR CSVs and on those evaluations.
+# Usage: scripts/raf_gap.sh [DIR]   (default build/raf_gap; OUT=build/experiments, NERAF=build/neraf)
+# Writes DIR/eval_sN.json, DIR/csv_sN/ and DIR/raf_gap.json. About 2 min on 2 cores.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+DIR=${1:-build/raf_gap}
+OUT=${OUT:-build/experiments}
+NERAF=${NERAF:-build/neraf}
+for s in 1 2 3; do
+  [ -f "$OUT/runs/e2_raf_furnished_full_s$s/done" ] || {
+    echo "raf_gap: $OUT/runs/e2_raf_furnished_full_s$s is not a finished run; make it with" \
+      "EXPERIMENTS=2 E2_ROOMS=raf_furnished scripts/experiments.sh" >&2
+    exit 1
+  }
+done
+mkdir -p "$DIR"
+"$NERAF" synth --preset furnished_room --mics random --mic-count 200 --seed 4 \
+  --gain-from "$OUT/data/raf_furnished" --out "$DIR/novel400" --force --quiet
+evals=()
+for s in 1 2 3; do
+  # --images: the per-RIR CSVs go to DIR, so the run's own (experiment 2's) stay as they are
+  "$NERAF" eval --run "$OUT/runs/e2_raf_furnished_full_s$s" --skip-vision --no-images --quiet \
+    --novel-data "$DIR/novel400" --images "$DIR/csv_s$s" --json "$DIR/eval_s$s.json" >/dev/null
+  evals+=("$DIR/eval_s$s.json")
+done
+/usr/bin/python3 scripts/raf_gap.py --out "$OUT" --neraf "$NERAF" --evals "${evals[@]}" \
+  --json "$DIR/raf_gap.json"
