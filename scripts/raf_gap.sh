@@ -6,7 +6,7 @@
 #      seed's run by `neraf eval --novel-data` (which scores the 60 held-out RIRs again too);
 #   2. scripts/raf_gap.py on the runs' own per-RIR CSVs and on those evaluations.
 # Usage: scripts/raf_gap.sh [DIR]   (default build/raf_gap; OUT=build/experiments, NERAF=build/neraf)
-# Writes DIR/eval_sN.json, DIR/csv_sN/ and DIR/raf_gap.json. About 2 min on 2 cores.
+# Writes DIR/eval_sN.json, DIR/csv_sN/ and DIR/raf_gap.json. About 3 min on 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DIR=${1:-build/raf_gap}
