@@ -20,10 +20,11 @@ code). Writes one JSON:
                       error is seed-to-seed scatter, which averaging removes, and how much is
                       shared by every seed)
   evals               (--evals, one `neraf eval --novel-data` JSON per seed, scripts/raf_gap.sh)
-                      per part (held_out, novel): RIRs, each method's mean error over seeds, and
-                      per baseline and metric the paired difference neraf - baseline: mean over
-                      seeds, its standard error over seeds, each seed's per-RIR standard error,
-                      and the seeds where neraf is better by more than two of those
+                      per part (held_out, novel): RIRs, each method's and ablation's mean error
+                      over seeds, and per baseline or ablation and metric the paired difference
+                      neraf - it: mean over seeds, its standard error over seeds, each seed's
+                      per-RIR standard error, and the seeds where neraf is better by more than
+                      two of those
 """
 import argparse
 import csv
@@ -76,28 +77,35 @@ def column(rows, ids, key):  # [RIRs, seeds]
     return np.array([[float(r[key]) for r in rows[i]] for i in ids])
 
 
+def by_label(runs):
+    """{e2_raf_furnished_S24_s1: x} -> {S24: x}: an ablation run's name without room and seed."""
+    return {n.removeprefix("e2_raf_furnished_").rsplit("_s", 1)[0]: v for n, v in runs.items()}
+
+
 def summarise_evals(paths):
     audio = []
     for path in paths:
         with open(path) as f:
             audio.append(json.load(f)["audio"])
-    parts = {}
+    parts = {"files": list(paths)}
     for part, pick in [("held_out", lambda a: a), ("novel", lambda a: a["novel"])]:
         seeds = [pick(a) for a in audio]
+        errors = [e | by_label(e.get("ablations", {})) for e in seeds]
+        paired = [e["paired"] | by_label(e.get("paired_ablations", {})) for e in seeds]
+        labels = list(by_label(seeds[0].get("ablations", {})))
         summary = {"rirs": seeds[0]["neraf"]["n_rirs"]}
-        for m in METHODS:
-            summary[m] = {k: float(np.mean([e[m][k] for e in seeds])) for k in ERRORS}
-        for b in ["nearest", "linear"]:
-            summary["neraf_minus_" + b] = {}
+        for m in METHODS + labels:
+            summary[m] = {k: float(np.mean([e[m][k] for e in errors])) for k in ERRORS}
+        for other in ["nearest", "linear"] + labels:
+            summary["neraf_minus_" + other] = {}
             for k in ERRORS:
-                d = np.array([e["paired"][b][k]["mean_difference"] for e in seeds])
-                se = np.array([e["paired"][b][k]["standard_error"] for e in seeds])
-                summary["neraf_minus_" + b][k] = {
+                d = np.array([p[other][k]["mean_difference"] for p in paired])
+                se = np.array([p[other][k]["standard_error"] for p in paired])
+                summary["neraf_minus_" + other][k] = {
                     "mean_difference": float(d.mean()),
                     "se_over_seeds": float(d.std(ddof=1) / np.sqrt(len(d))),
                     "per_rir_se": se.tolist(), "wins": int((d < -2 * se).sum())}
         parts[part] = summary
-    parts["files"] = list(paths)
     return parts
 
 

@@ -3,30 +3,39 @@
 # experiment 2's full-model runs (made by `EXPERIMENTS=2 scripts/experiments.sh`; read, not changed):
 #   1. a larger set of new microphone positions than the experiments' 80 RIRs: 200 random
 #      microphones x 2 sources = 400 RIRs of the same room (neraf synth, seed 4), scored with each
-#      seed's run by `neraf eval --novel-data` (which scores the 60 held-out RIRs again too);
+#      seed's run and its grid ablations (--ablation-runs: experiment 2's other variants of the
+#      same seed) by `neraf eval --novel-data`, which scores the 60 held-out RIRs again too;
 #   2. scripts/raf_gap.py on the runs' own per-RIR CSVs and on those evaluations.
 # Usage: scripts/raf_gap.sh [DIR]   (default build/raf_gap; OUT=build/experiments, NERAF=build/neraf)
-# Writes DIR/eval_sN.json, DIR/csv_sN/ and DIR/raf_gap.json. About 3 min on 2 cores.
+# Writes DIR/eval_sN.json, DIR/csv_sN/ and DIR/raf_gap.json. About 5 min on 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DIR=${1:-build/raf_gap}
 OUT=${OUT:-build/experiments}
 NERAF=${NERAF:-build/neraf}
+VARIANTS="full grid_none grid_zeros S24 S64 features_local features_both"
 for s in 1 2 3; do
-  [ -f "$OUT/runs/e2_raf_furnished_full_s$s/done" ] || {
-    echo "raf_gap: $OUT/runs/e2_raf_furnished_full_s$s is not a finished run; make it with" \
-      "EXPERIMENTS=2 E2_ROOMS=raf_furnished scripts/experiments.sh" >&2
-    exit 1
-  }
+  for v in $VARIANTS; do
+    [ -f "$OUT/runs/e2_raf_furnished_${v}_s$s/done" ] || {
+      echo "raf_gap: $OUT/runs/e2_raf_furnished_${v}_s$s is not a finished run; make it with" \
+        "EXPERIMENTS=2 E2_ROOMS=raf_furnished scripts/experiments.sh" >&2
+      exit 1
+    }
+  done
 done
 mkdir -p "$DIR"
 "$NERAF" synth --preset furnished_room --mics random --mic-count 200 --seed 4 \
   --gain-from "$OUT/data/raf_furnished" --out "$DIR/novel400" --force --quiet
 evals=()
 for s in 1 2 3; do
+  ablations=()
+  for v in $VARIANTS; do
+    [ "$v" = full ] || ablations+=("$OUT/runs/e2_raf_furnished_${v}_s$s")
+  done
   # --images: the per-RIR CSVs go to DIR, so the run's own (experiment 2's) stay as they are
   "$NERAF" eval --run "$OUT/runs/e2_raf_furnished_full_s$s" --skip-vision --no-images --quiet \
-    --novel-data "$DIR/novel400" --images "$DIR/csv_s$s" --json "$DIR/eval_s$s.json" >/dev/null
+    --novel-data "$DIR/novel400" --images "$DIR/csv_s$s" --json "$DIR/eval_s$s.json" \
+    --ablation-runs "$(IFS=,; echo "${ablations[*]}")" >/dev/null
   evals+=("$DIR/eval_s$s.json")
 done
 /usr/bin/python3 scripts/raf_gap.py --out "$OUT" --neraf "$NERAF" --evals "${evals[@]}" \
