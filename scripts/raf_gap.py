@@ -31,6 +31,7 @@ import csv
 import json
 import os
 import platform
+import re
 import subprocess
 import sys
 import time
@@ -79,7 +80,7 @@ def column(rows, ids, key):  # [RIRs, seeds]
 
 def by_label(runs):
     """{e2_raf_furnished_S24_s1: x} -> {S24: x}: an ablation run's name without room and seed."""
-    return {n.removeprefix("e2_raf_furnished_").rsplit("_s", 1)[0]: v for n, v in runs.items()}
+    return {re.sub(r"^e\d_raf_furnished_", "", n).rsplit("_s", 1)[0]: v for n, v in runs.items()}
 
 
 def summarise_evals(paths):

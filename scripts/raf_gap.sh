@@ -1,10 +1,11 @@
 #!/bin/bash
 # Where the default neraf loses to the baselines in the RAF-layout furnished room (issue 13), on
-# experiment 2's full-model runs (made by `EXPERIMENTS=2 scripts/experiments.sh`; read, not changed):
+# experiments 2 and 5's runs (made by `EXPERIMENTS="2 5" scripts/experiments.sh`; read, not changed):
 #   1. a larger set of new microphone positions than the experiments' 80 RIRs: 200 random
 #      microphones x 2 sources = 400 RIRs of the same room (neraf synth, seed 4), scored with each
-#      seed's run and its grid ablations (--ablation-runs: experiment 2's other variants of the
-#      same seed) by `neraf eval --novel-data`, which scores the 60 held-out RIRs again too;
+#      seed's run, its grid ablations and loss variants (--ablation-runs: experiments 2's and 5's
+#      other runs of the same seed) by `neraf eval --novel-data`, which scores the 60 held-out
+#      RIRs again too;
 #   2. scripts/raf_gap.py on the runs' own per-RIR CSVs and on those evaluations.
 # Usage: scripts/raf_gap.sh [DIR]   (default build/raf_gap; OUT=build/experiments, NERAF=build/neraf)
 # Writes DIR/eval_sN.json, DIR/csv_sN/ and DIR/raf_gap.json. About 5 min on 2 cores.
@@ -13,12 +14,14 @@ cd "$(dirname "$0")/.."
 DIR=${1:-build/raf_gap}
 OUT=${OUT:-build/experiments}
 NERAF=${NERAF:-build/neraf}
-VARIANTS="full grid_none grid_zeros S24 S64 features_local features_both"
+VARIANTS="e2_full e2_grid_none e2_grid_zeros e2_S24 e2_S64 e2_features_local e2_features_both
+  e5_loss_sc_sll1 e5_loss_mse"
 for s in 1 2 3; do
   for v in $VARIANTS; do
-    [ -f "$OUT/runs/e2_raf_furnished_${v}_s$s/done" ] || {
-      echo "raf_gap: $OUT/runs/e2_raf_furnished_${v}_s$s is not a finished run; make it with" \
-        "EXPERIMENTS=2 E2_ROOMS=raf_furnished scripts/experiments.sh" >&2
+    run=$OUT/runs/${v%%_*}_raf_furnished_${v#*_}_s$s
+    [ -f "$run/done" ] || {
+      echo "raf_gap: $run is not a finished run; make it with" \
+        "EXPERIMENTS=\"2 5\" E2_ROOMS=raf_furnished scripts/experiments.sh" >&2
       exit 1
     }
   done
@@ -30,7 +33,7 @@ evals=()
 for s in 1 2 3; do
   ablations=()
   for v in $VARIANTS; do
-    [ "$v" = full ] || ablations+=("$OUT/runs/e2_raf_furnished_${v}_s$s")
+    [ "$v" = e2_full ] || ablations+=("$OUT/runs/${v%%_*}_raf_furnished_${v#*_}_s$s")
   done
   # --images: the per-RIR CSVs go to DIR, so the run's own (experiment 2's) stay as they are
   "$NERAF" eval --run "$OUT/runs/e2_raf_furnished_full_s$s" --skip-vision --no-images --quiet \
