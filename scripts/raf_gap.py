@@ -30,13 +30,14 @@ import argparse
 import csv
 import json
 import os
-import platform
 import re
 import subprocess
 import sys
 import time
 
 import numpy as np
+
+from experiments_report import machine
 
 METHODS = ["neraf", "nearest", "linear", "griffin_lim_floor"]
 SEEDS = [1, 2, 3]
@@ -54,10 +55,13 @@ def pose(data, rir_id):  # (mic xyz, source xyz): tx_pos.txt is 4 rotation value
     return vector(os.path.join(d, "rx_pos.txt")), vector(os.path.join(d, "tx_pos.txt"))[4:]
 
 
-def cpu_model():
-    with open("/proc/cpuinfo") as f:
-        names = [line.split(":", 1)[1].strip() for line in f if line.startswith("model name")]
-    return f"{names[0] if names else platform.machine()}, {os.cpu_count()} cores"
+def need(path, fix):
+    """Stops with one line naming `path` and the fix when it does not exist."""
+    if not os.path.exists(path):
+        sys.exit(f"raf_gap: {path}: missing; {fix}")
+
+
+MAKE_RUNS = "EXPERIMENTS=\"2 5\" E2_ROOMS=raf_furnished scripts/experiments.sh makes it"
 
 
 def per_rir(out, csv_name):
@@ -65,9 +69,7 @@ def per_rir(out, csv_name):
     rows = {}
     for s in SEEDS:
         path = os.path.join(out, "runs", f"e2_raf_furnished_full_s{s}", "eval", csv_name)
-        if not os.path.isfile(path):
-            sys.exit(f"raf_gap: {path}: missing; make experiment 2's furnished-room runs with "
-                     "EXPERIMENTS=2 E2_ROOMS=raf_furnished scripts/experiments.sh")
+        need(path, MAKE_RUNS)
         with open(path) as f:
             for r in csv.DictReader(f):
                 rows.setdefault(r["method"], {}).setdefault(r["rir_id"], []).append(r)
@@ -120,13 +122,15 @@ def main():
 
     data = os.path.join(a.out, "data", "raf_furnished")
     split_file = os.path.join(data, "metadata", "data-split.json")
-    if not os.path.isfile(split_file):
-        sys.exit(f"raf_gap: {split_file}: missing; scripts/experiments.sh makes the furnished "
-                 "room's data (EXPERIMENTS=2 E2_ROOMS=raf_furnished), or give its OUT with --out")
+    novel_data = data + "_novel"
+    need(split_file, MAKE_RUNS + " (or give its OUT with --out)")
+    need(os.path.join(novel_data, "data"), MAKE_RUNS)
+    need(a.neraf, "build it with scripts/build.sh, or give the program with --neraf")
+    for path in a.evals:
+        need(path, "scripts/raf_gap.sh makes the evaluations")
     with open(split_file) as f:
         split = json.load(f)
     train, test = split["train"][0], split["test"][0]
-    novel_data = data + "_novel"
     novel = sorted(os.listdir(os.path.join(novel_data, "data")))
     train_mic = {i: pose(data, i)[0] for i in train}
 
@@ -134,7 +138,7 @@ def main():
         return next((i for i, m in train_mic.items() if np.allclose(m, mic)), None)
 
     result = {"command": " ".join(["scripts/raf_gap.py"] + sys.argv[1:]), "runs":
-              [f"e2_raf_furnished_full_s{s}" for s in SEEDS], "machine": cpu_model(),
+              [f"e2_raf_furnished_full_s{s}" for s in SEEDS], "machine": f"{machine()}, {os.cpu_count()} cores",
               "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())}
     splits = {"held_out": (per_rir(a.out, "audio_per_rir.csv"), test, data),
               "novel": (per_rir(a.out, "audio_novel_per_rir.csv"), novel, novel_data)}
@@ -148,9 +152,12 @@ def main():
 
     def c50_of(rir_id):
         wav = os.path.join(data, "data", rir_id, "rir.wav")
-        out = subprocess.run([a.neraf, "metrics", "--rir", wav, "--json"], check=True,
-                             capture_output=True, text=True).stdout
-        return json.loads(out)["channels"][0]["c50"]
+        done = subprocess.run([a.neraf, "metrics", "--rir", wav, "--json"], capture_output=True,
+                              text=True)
+        if done.returncode != 0:
+            sys.exit(f"raf_gap: {a.neraf} metrics --rir {wav} failed (exit {done.returncode}): "
+                     f"{done.stderr.strip()}")
+        return json.loads(done.stdout)["channels"][0]["c50"]
 
     rows = splits["held_out"][0]
     own = column(rows["neraf"], shared, "c50_gt_db")[:, 0]
