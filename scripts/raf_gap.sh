@@ -26,6 +26,10 @@ for s in 1 2 3; do
     }
   done
 done
+/usr/bin/python3 -c 'import numpy' 2>/dev/null || {
+  echo "raf_gap: /usr/bin/python3 has no numpy; install it with: apt-get install python3-numpy" >&2
+  exit 1
+}
 mkdir -p "$DIR"
 "$NERAF" synth --preset furnished_room --mics random --mic-count 200 --seed 4 \
   --gain-from "$OUT/data/raf_furnished" --out "$DIR/novel400" --force --quiet
