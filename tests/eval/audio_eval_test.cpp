@@ -230,6 +230,7 @@ TEST(AudioEval, TrainingDifferenceAllowsOnlyTheAblationKnobs) {
   knobs.audio.grid_resolution = 16;
   knobs.audio.relative_geometry = false;
   knobs.audio.position_max_freq_exp = 3;
+  knobs.audio.average_fraction = 0.5;
   knobs.threads = 3;
   knobs.save_every = 7;
   knobs.audio.cache_dir = "/elsewhere";

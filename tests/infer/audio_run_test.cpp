@@ -15,6 +15,7 @@
 #include "neraf/infer/checkpoint.h"
 #include "neraf/infer/exported_model.h"
 #include "neraf/io/json_file.h"
+#include "neraf/train/audio_branch.h"
 #include "neraf/train/trainer.h"
 #include "neraf/util/error.h"
 
@@ -121,6 +122,75 @@ TEST(AudioRun, ConcurrentQueriesMatchSequentialOnes) {
     EXPECT_EQ(got_wave[k], expected_wave) << "thread " << k;
   }
   EXPECT_FALSE(run.model()->is_training());
+}
+
+// --audio-average: the saved "model_average" is the mean of the acoustic model's weights after
+// each of the last share of audio steps (a slow reference: snapshots averaged in double), a run
+// resumed inside the window ends with the same mean, and load_audio_run answers with it; "model"
+// keeps the last step's weights for resuming.
+TEST(AudioRun, WeightAveragedRunLoadsTheMeanOfItsLastSteps) {
+  torch::manual_seed(0);
+  const std::string dir = make_temp_dir("average");
+  const data::RirSet rirs = tiny_rir_set(dir);
+  const data::ImageSet images = make_image_set();
+  TrainConfig c = tiny_joint_config();
+  c.steps = 6;
+  c.audio.average_fraction = 0.5;  // audio on steps 0..5 (start −1): the mean of steps 3, 4, 5
+  const std::string run_dir = dir + "/run";
+  auto trainer = train::make_trainer(c, &images, torch::kCPU, &rirs);
+  auto* audio = dynamic_cast<train::AudioBranch*>(trainer->branch("audio"));
+  ASSERT_NE(audio, nullptr);
+  std::vector<torch::Tensor> sum;  // float64, per parameter
+  for (int step = 0; step < 6; ++step) {
+    trainer->step();
+    if (step == 3) trainer->save_checkpoint(dir + "/step4.pt");  // one step into the window
+    EXPECT_EQ(audio->averaged_steps(), std::max(0, step - 2)) << "after step " << step;
+    if (step < 3) continue;
+    const std::vector<torch::Tensor> w = audio->model()->parameters();
+    for (size_t i = 0; i < w.size(); ++i) {
+      const torch::Tensor x = w[i].detach().to(torch::kFloat64);
+      if (sum.size() < w.size())
+        sum.push_back(x.clone());
+      else
+        sum[i] += x;
+    }
+  }
+  trainer->save_checkpoint(checkpoint_path(run_dir, 6));
+  io::write_json_atomically(run_dir + "/config.json", to_json(c));
+  io::write_json_atomically(run_dir + "/data.json", {{"audio", make_audio_manifest(rirs)}});
+  const AudioRun run = load_audio_run(run_dir, torch::kCPU, "", nerf::Precision::fp32, false);
+  const std::vector<torch::Tensor> loaded = run.model()->parameters();
+  const std::vector<torch::Tensor> last = audio->model()->parameters();
+  ASSERT_EQ(loaded.size(), sum.size());
+  bool any_moved = false;
+  for (size_t i = 0; i < sum.size(); ++i) {
+    const torch::Tensor mean = sum[i] / 3.0;
+    EXPECT_TRUE(torch::allclose(loaded[i].to(torch::kFloat64), mean, 1e-5, 1e-6)) << "param " << i;
+    any_moved = any_moved || !torch::allclose(last[i].to(torch::kFloat64), mean, 1e-5, 1e-6);
+  }
+  EXPECT_TRUE(any_moved);  // the mean is not the last step's weights
+
+  // Resumed one step into the window: the same two steps give the same mean, bit for bit.
+  torch::manual_seed(123);
+  auto resumed = train::make_trainer(c, &images, torch::kCPU, &rirs);
+  resumed->load_checkpoint(dir + "/step4.pt");
+  auto* audio_resumed = dynamic_cast<train::AudioBranch*>(resumed->branch("audio"));
+  EXPECT_EQ(audio_resumed->averaged_steps(), 1);
+  resumed->step();
+  resumed->step();
+  const std::string resumed_dir = dir + "/resumed";
+  resumed->save_checkpoint(checkpoint_path(resumed_dir, 6));
+  io::write_json_atomically(resumed_dir + "/config.json", to_json(c));
+  io::write_json_atomically(resumed_dir + "/data.json", {{"audio", make_audio_manifest(rirs)}});
+  const std::vector<torch::Tensor> again =
+      load_audio_run(resumed_dir, torch::kCPU, "", nerf::Precision::fp32, false)
+          .model()
+          ->parameters();
+  const std::vector<torch::Tensor> resumed_last = audio_resumed->model()->parameters();
+  for (size_t i = 0; i < again.size(); ++i) {
+    EXPECT_TRUE(torch::equal(again[i], loaded[i])) << "param " << i;
+    EXPECT_TRUE(torch::equal(resumed_last[i], last[i])) << "param " << i;
+  }
 }
 
 // A run that reads its grid per query (--grid-features both) answers through the world map of

@@ -177,6 +177,7 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
   f.grid_features = "both";
   f.position_max_freq_exp = 3;
   f.decay_heads = true;
+  f.audio_average = 0.25;
   f.no_relative_geometry = true;
   for (Modality m : {Modality::vision, Modality::joint}) {
     const TrainConfig c = resolve("cpu", m, f);
@@ -195,6 +196,7 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
     EXPECT_EQ(c.audio.grid_features, "both");
     EXPECT_EQ(c.audio.position_max_freq_exp, 3);
     EXPECT_TRUE(c.audio.decay_heads);
+    EXPECT_EQ(c.audio.average_fraction, 0.25);
     EXPECT_FALSE(c.audio.relative_geometry);
   }
   // Unset flags keep the preset's values.
@@ -209,6 +211,7 @@ TEST(ResolveTrainConfig, ExplicitFlagsWin) {
   EXPECT_EQ(cpu.audio.grid_resolution, 32);
   EXPECT_EQ(cpu.audio.grid_features, "global");  // the published design
   EXPECT_FALSE(cpu.audio.decay_heads);
+  EXPECT_EQ(cpu.audio.average_fraction, 0.0);  // the last step's weights
   EXPECT_EQ(resolve("paper", Modality::joint).audio.grid_resolution, 128);
   EXPECT_EQ(resolve("paper", Modality::joint).seed, 42u);
 }
@@ -331,6 +334,9 @@ TEST(TrainConfig, ReferencePresetIsThePublishedModel) {
   EXPECT_THROW(validate(bad, "config.json"), Error);
   bad = joint;
   bad.audio.view_directions = "fibonacci";
+  EXPECT_THROW(validate(bad, "config.json"), Error);
+  bad = joint;
+  bad.audio.average_fraction = 1.5;
   EXPECT_THROW(validate(bad, "config.json"), Error);
   EXPECT_NO_THROW(validate(joint, "config.json"));
 }

@@ -134,6 +134,7 @@ nlohmann::json score_audio(const infer::AudioField& run, const std::vector<Ablat
       abl[a.label]["loss"] = a.run.run().config.audio.loss;
       abl[a.label]["position_max_freq_exp"] = a.run.run().config.audio.position_max_freq_exp;
       abl[a.label]["decay_heads"] = a.run.run().config.audio.decay_heads;
+      abl[a.label]["average_fraction"] = a.run.run().config.audio.average_fraction;
       abl[a.label]["post_processing"] = m.post_processing;
       labels.push_back(a.label);
       e.methods.push_back(std::move(m));
@@ -494,8 +495,8 @@ void register_eval(CLI::App& app) {
       "\"neraf_uncalibrated\" without, as the linear baseline is rendered (each row states its\n"
       "post-processing). --ablation-runs must have trained exactly as --run but for audio.grid,\n"
       "audio.grid_features, audio.grid_resolution, audio.relative_geometry, audio.loss,\n"
-      "audio.position_max_freq_exp or audio.decay_heads (same modality, preset, steps, seed,\n"
-      "data; else refused).\n"
+      "audio.position_max_freq_exp, audio.decay_heads or audio.average_fraction (same\n"
+      "modality, preset, steps, seed, data; else refused).\n"
       "Baselines:\n"
       "nearest = the measured RIR of the closest training mic with the same heading and source;\n"
       "linear = inverse-distance blend of the 2-4 closest such training RIRs' magnitudes +\n"
@@ -557,10 +558,11 @@ void register_eval(CLI::App& app) {
   cmd->add_option("--ablation-runs", args->ablation_runs,
                   "Audio: comma-separated run folders trained exactly as --run but for the "
                   "ablated option (--grid, --grid-features, --grid-resolution, --audio-loss, "
-                  "--no-relative-geometry, --position-max-freq-exp; same modality, "
-                  "preset, steps, seed and data, else refused), scored on the same test RIRs and "
-                  "added to the table and JSON (audio.ablations, labelled by folder name, and "
-                  "audio.paired_ablations: --run − each)");
+                  "--no-relative-geometry, --position-max-freq-exp, --decay-heads, "
+                  "--audio-average; same modality, preset, steps, seed and data, else refused), "
+                  "scored on the same test RIRs and added to the table and JSON "
+                  "(audio.ablations, labelled by folder name, and audio.paired_ablations: --run "
+                  "− each)");
   cmd->add_option("--novel-data", args->novel_data,
                   "Audio: another dataset of the same room (same layout and rates, e.g. "
                   "`neraf synth --preset demo --mics random`): every RIR of it is scored as well, "

@@ -60,6 +60,8 @@ struct TrainArgs {
   CLI::Option* position_max_freq_exp_opt = nullptr;
   bool decay_heads = false;
   CLI::Option* decay_heads_opt = nullptr;
+  double audio_average = 0;
+  CLI::Option* audio_average_opt = nullptr;
   CLI::Option* modality_opt = nullptr;
   int keep = 3;
   int64_t save_every = 0;
@@ -240,6 +242,12 @@ void register_train(CLI::App& app) {
       "Give the acoustic field a decay slope per frequency beside each output level, so a "
       "tail's decay rate is stated per query (ours, an experiment; runs trained with it cannot "
       "be exported to the runtime)");
+  args->audio_average_opt =
+      cmd->add_option("--audio-average", args->audio_average,
+                      "Share of the audio steps at the end of the run over which the acoustic "
+                      "field's weights are averaged; eval, render and export then use the "
+                      "average (ours, an experiment; default 0 = the last step's weights)")
+          ->check(real_number(0, 1));
   cmd->add_option("--out", args->out, "Run folder to create (or to resume)")->required();
   cmd->add_flag("--resume", args->resume,
                 "Continue the run in --out from its latest checkpoint (uses its config.json)");
@@ -350,6 +358,7 @@ void register_train(CLI::App& app) {
       flags.position_max_freq_exp = args->position_max_freq_exp;
     flags.no_relative_geometry = args->no_relative_geometry;
     flags.decay_heads = args->decay_heads;
+    if (args->audio_average_opt->count()) flags.audio_average = args->audio_average;
     flags.vision_runs = args->vision_run;
     require(args->data.size() <= 1 || args->modality == "audio",
             "--data: given " + std::to_string(args->data.size()) +
@@ -367,10 +376,11 @@ void register_train(CLI::App& app) {
                 "same order");
 
     if (flags.modality == infer::Modality::vision)
-      for (CLI::Option* o : {grid, grid_features, args->grid_resolution_opt,
-                             args->position_max_freq_exp_opt, fraction, audio_start, decay_loss,
-                             args->audio_loss_opt, no_relative, args->decay_heads_opt,
-                             args->max_len_opt, args->cache_dir_opt, args->cache_precision_opt})
+      for (CLI::Option* o :
+           {grid, grid_features, args->grid_resolution_opt, args->position_max_freq_exp_opt,
+            fraction, audio_start, decay_loss, args->audio_loss_opt, no_relative,
+            args->decay_heads_opt, args->audio_average_opt, args->max_len_opt, args->cache_dir_opt,
+            args->cache_precision_opt})
         require(o->count() == 0, o->get_name() +
                                      ": sets the acoustic field, which --modality vision does "
                                      "not train; drop it (or train --modality joint)");
@@ -420,7 +430,7 @@ void register_train(CLI::App& app) {
       for (CLI::Option* o :
            {args->cache_dir_opt, args->cache_precision_opt, args->max_len_opt, args->audio_loss_opt,
             args->grid_resolution_opt, args->position_max_freq_exp_opt, args->decay_heads_opt,
-            args->modality_opt})
+            args->audio_average_opt, args->modality_opt})
         require(o->count() == 0, o->get_name() +
                                      ": cannot change on --resume (the run's config.json records "
                                      "it); start a new run with --out to change it");

@@ -417,7 +417,8 @@ std::vector<std::string> ablation_knobs() {
           "audio.relative_geometry",
           "audio.loss",
           "audio.position_max_freq_exp",
-          "audio.decay_heads"};
+          "audio.decay_heads",
+          "audio.average_fraction"};
 }
 
 std::string training_difference(const nlohmann::json& main_config, const nlohmann::json& main_data,

@@ -130,7 +130,7 @@ std::string training_difference(const nlohmann::json& main_config, const nlohman
                                 const nlohmann::json& other_data);
 // The config.json keys an ablation may change: audio.grid, audio.grid_features,
 // audio.grid_resolution, audio.relative_geometry, audio.loss, audio.position_max_freq_exp,
-// audio.decay_heads.
+// audio.decay_heads, audio.average_fraction.
 std::vector<std::string> ablation_knobs();
 // Writes "rir_id,method,t60_error_pct,c50_error_db,edt_error_s,stft_error,invalid_t60,
 // t60_pred_s,t60_gt_s,c50_pred_db,c50_gt_db" rows (the last four: channel means of the measured

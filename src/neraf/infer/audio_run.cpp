@@ -226,7 +226,8 @@ AudioRun load_audio_run(const std::string& run_dir, torch::Device device,
   try {
     torch::serialize::InputArchive branch, m, g;
     a.read("branch_audio", branch);
-    branch.read("model", m);
+    // A run trained with --audio-average is used through its averaged weights.
+    if (!branch.try_read("model_average", m)) branch.read("model", m);
     load_module(*out.model_, m, out.run_.checkpoint);
     branch.read(scene_key("grid", out.scene_), g);
     load_module(*grid, g, out.run_.checkpoint);

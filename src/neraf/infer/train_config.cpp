@@ -57,6 +57,7 @@ TrainConfig resolve_train_config(const TrainFlags& f) {
   cfg.audio.grid = f.grid;
   if (f.grid_features) cfg.audio.grid_features = *f.grid_features;
   if (f.decay_loss) cfg.audio.decay_weight = *f.decay_loss;
+  if (f.audio_average) cfg.audio.average_fraction = *f.audio_average;
   if (f.audio_loss) cfg.audio.loss = *f.audio_loss;
   if (f.grid_resolution) cfg.audio.grid_resolution = *f.grid_resolution;
   if (f.position_max_freq_exp) cfg.audio.position_max_freq_exp = *f.position_max_freq_exp;
@@ -149,6 +150,8 @@ void validate(const TrainConfig& c, const std::string& where) {
   require(a.start_step >= -1, where + ".audio.start_step: must be >= -1");
   require(a.decay_weight >= 0 && std::isfinite(a.decay_weight),
           where + ".audio.decay_weight: must be a number >= 0 (--decay-loss)");
+  require(a.average_fraction >= 0 && a.average_fraction <= 1,
+          where + ".audio.average_fraction: must be in [0, 1] (--audio-average)");
   require(a.decay_rirs >= 1, where + ".audio.decay_rirs: must be at least 1");
   require(a.early_fraction >= 0 && a.early_fraction <= 1,
           where + ".audio.early_fraction: must be in [0, 1]");

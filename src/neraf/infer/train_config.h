@@ -86,6 +86,10 @@ struct AudioConfig {
   // NAcF's decay heads: a slope per bin beside each level head, out = output_scale·tanh(level +
   // τ·slope) (ours, off in every preset; --decay-heads; acoustic/nacf.h).
   bool decay_heads = false;
+  // Weight averaging (ours, off in every preset; --audio-average): the acoustic model that
+  // inference loads is the uniform average of its weights after each of the last share
+  // average_fraction of the audio steps (0 = off: the last step's weights). Training is unchanged.
+  double average_fraction = 0.0;
   // The grid sampler's 18 viewing directions: "spread" (ours: unit vectors spread over the
   // sphere) or "reference" (the published code's degenerate vectors; acoustic/grid_sampler.h).
   std::string view_directions = "spread";
@@ -128,6 +132,7 @@ struct AudioConfig {
     v("relative_geometry", relative_geometry);
     v("position_max_freq_exp", position_max_freq_exp);
     v("decay_heads", decay_heads);
+    v("average_fraction", average_fraction);
     v("view_directions", view_directions);
     v("resnet_batch_norm", resnet_batch_norm);
     v("vision_run", vision_run);
@@ -222,6 +227,7 @@ struct TrainFlags {
   std::optional<int64_t> grid_resolution;       // --grid-resolution
   std::optional<double> position_max_freq_exp;  // --position-max-freq-exp
   bool decay_heads = false;                     // --decay-heads
+  std::optional<double> audio_average;          // --audio-average
   bool no_relative_geometry = false;            // --no-relative-geometry
   // --vision-run, once per --data (stored as absolute paths); two or more make a multi-scene run.
   std::vector<std::string> vision_runs;
@@ -240,9 +246,9 @@ struct TrainFlags {
 //   - --audio-start-step S: start_step = S, and a warm-up that ended where audio started still
 //     ends there (max(0, S)).
 //   - --seed, --grid, --grid-resolution, --audio-fraction, --audio-loss, --decay-loss,
-//     --no-relative-geometry, --threads, --rays, --precision, --vision-run (made absolute)
-//     overwrite their setting; two or more --vision-run fill audio.vision_runs (multi-scene),
-//     the first also audio.vision_run.
+//     --audio-average, --no-relative-geometry, --threads, --rays, --precision, --vision-run (made
+//     absolute) overwrite their setting; two or more --vision-run fill audio.vision_runs
+//     (multi-scene), the first also audio.vision_run.
 // neraf::Error naming the flag: --vision-run without --modality audio, an unknown preset.
 // The result is not validated here (run_training validates the config it trains).
 TrainConfig resolve_train_config(const TrainFlags& flags);

@@ -302,10 +302,49 @@ LossDict AudioBranch::losses(StepContext& ctx) {
   return out;
 }
 
+void AudioBranch::after_step(int64_t step, int64_t total_steps) {
+  const double share = config_.audio.average_fraction;
+  if (share <= 0 || step <= config_.audio.start_step) return;
+  const int64_t audio_steps = total_steps - std::max<int64_t>(0, config_.audio.start_step + 1);
+  // (− 1e-9: a share × steps that is whole in decimals, 0.1 × 30, must not round up to 4.)
+  const auto window =
+      std::max<int64_t>(1, static_cast<int64_t>(std::ceil(share * audio_steps - 1e-9)));
+  if (step < total_steps - window) {
+    averaged_steps_ = 0;
+    return;
+  }
+  torch::NoGradGuard no_grad;
+  if (!average_) {
+    average_ = acoustic::AcousticModel(model_->options());  // its weights are overwritten
+    average_->to(device_);
+  }
+  const std::vector<torch::Tensor> params = model_->parameters();
+  std::vector<torch::Tensor> mean = average_->parameters();
+  ++averaged_steps_;
+  for (size_t i = 0; i < params.size(); ++i) {
+    if (averaged_steps_ == 1)
+      mean[i].copy_(params[i]);
+    else
+      mean[i].add_(params[i] - mean[i], 1.0 / static_cast<double>(averaged_steps_));
+  }
+}
+
 void AudioBranch::save(torch::serialize::OutputArchive& archive) {
   torch::serialize::OutputArchive m;
   model_->save(m);
   archive.write("model", m);
+  if (averaged_steps_ > 0) {
+    {
+      torch::NoGradGuard no_grad;
+      const std::vector<torch::Tensor> from = model_->buffers();  // BatchNorm statistics
+      std::vector<torch::Tensor> to = average_->buffers();
+      for (size_t i = 0; i < from.size(); ++i) to[i].copy_(from[i]);
+    }
+    torch::serialize::OutputArchive a;
+    average_->save(a);
+    archive.write("model_average", a);
+    archive.write("average_steps", torch::tensor(averaged_steps_, torch::kInt64));
+  }
   for (size_t s = 0; s < scenes_.size(); ++s) {
     // The step's backward is done: cut the fresh cells' autograd history so that only values are
     // serialised (the next update detaches the grid anyway).
@@ -344,6 +383,16 @@ void AudioBranch::load(torch::serialize::InputArchive& archive, const std::strin
   archive.read("model", m);
   infer::load_module(*model_, m, where);
   model_->to(device_);
+  torch::serialize::InputArchive a;
+  averaged_steps_ = 0;
+  if (archive.try_read("model_average", a)) {
+    if (!average_) average_ = acoustic::AcousticModel(model_->options());
+    infer::load_module(*average_, a, where);
+    average_->to(device_);
+    torch::Tensor n;
+    archive.read("average_steps", n);
+    averaged_steps_ = n.item<int64_t>();
+  }
   for (size_t s = 0; s < scenes_.size(); ++s) {
     Scene& sc = scenes_[s];
     torch::serialize::InputArchive g;

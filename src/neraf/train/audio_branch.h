@@ -79,8 +79,14 @@ class AudioBranch : public Branch {
   std::vector<ParamGroup> param_groups() override;
   LossDict losses(StepContext& ctx) override;
   void set_training(bool training) override;
-  // Saves "model" (AcousticModel), "grid" (GridSampler: grid + pointer) and the data sampler
-  // ("perm", "cursor") so a killed run resumes exactly; scene s ≥ 1 of a multi-scene run adds
+  // Weight averaging (config audio.average_fraction > 0): adds the acoustic model's weights after
+  // each audio step of the run's last average_fraction of audio steps to their running mean. A
+  // step before that window (a resumed run made longer) starts the mean over.
+  void after_step(int64_t step, int64_t total_steps) override;
+  // Saves "model" (AcousticModel, the last step's weights), "grid" (GridSampler: grid + pointer)
+  // and the data sampler ("perm", "cursor") so a killed run resumes exactly; once averaging has
+  // begun "model_average" (the same model with the averaged parameters, which inference loads
+  // instead: infer/audio_run.h) and "average_steps"; scene s ≥ 1 of a multi-scene run adds
   // "grid_s", "manifest_s", "train_rirs_s" and "num_scenes" (infer::scene_key). (The energy
   // calibration is a stage of its own after training: infer/calibration.h.)
   void save(torch::serialize::OutputArchive& archive) override;
@@ -92,6 +98,7 @@ class AudioBranch : public Branch {
     return scenes_[scene].train_rirs;
   }
   size_t num_scenes() const { return scenes_.size(); }
+  int64_t averaged_steps() const { return averaged_steps_; }
   // The radiance-field query the grid of `scene` uses (density, rgb at u with train image 0's
   // appearance).
   acoustic::FieldQueryFn field_query(size_t scene = 0);
@@ -128,6 +135,10 @@ class AudioBranch : public Branch {
   int64_t cursor_ = 0;    // next position in perm_
   torch::Tensor batch_;   // [B + D·T, C, F] float32 gather buffer
   SaturationWatch saturation_;
+  // Weight averaging: a model of the same options whose parameters are the running mean (its
+  // buffers are copied from model_ when saved); null until averaging begins.
+  acoustic::AcousticModel average_{nullptr};
+  int64_t averaged_steps_ = 0;  // steps in the mean
 };
 
 }  // namespace neraf::train

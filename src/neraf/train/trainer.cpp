@@ -237,6 +237,7 @@ StepResult Trainer::step() {
       total.backward();
     }
     for (auto& g : groups_) g.optimizer->step();
+    for (auto& b : branches_) b->after_step(step_, config_.steps);
     if (dist_) {
       result.loss = 0;
       for (const auto& [k, v] : result.losses) result.loss += v;

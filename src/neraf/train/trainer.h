@@ -74,6 +74,9 @@ class Branch {
   // objective). May return an empty dict (branch inactive this step).
   virtual LossDict losses(StepContext& ctx) = 0;
   virtual int64_t rays_per_step() const { return 0; }  // throughput report (vision rays)
+  // After the optimizers have applied step `step` (0-based; a step with losses) of a run of
+  // `total_steps`.
+  virtual void after_step(int64_t step, int64_t total_steps) {}
   virtual void set_training(bool training) = 0;
   virtual void save(torch::serialize::OutputArchive& archive) = 0;
   // `where` names the checkpoint file for error messages.
@@ -132,8 +135,8 @@ class Trainer {
   void add_branch(std::unique_ptr<Branch> branch);
 
   // One optimisation step: LRs from the schedules, zero grads, every branch's losses, backward,
-  // every optimizer steps. DivergedError naming the term when a loss is not finite (nothing is
-  // applied then).
+  // every optimizer steps, every branch's after_step. DivergedError naming the term when a loss is
+  // not finite (nothing is applied then).
   StepResult step();
   int64_t completed_steps() const { return step_; }
 
