@@ -1,0 +1,116 @@
+#!/bin/bash
+# Does the grid help where measurements are few? Issue 13's occluded-room target asks the sampled
+# grid to beat the zero grid; with all 720 training RIRs the acoustic field learns the partition
+# from positions alone (docs/RESULTS.md, experiment 2). This trains experiment 2's occluded-room
+# models (audio-only on a frozen vision run, cpu preset, 1500 steps) on a seeded share F of the
+# training RIRs, seeds 1-3, three ways: the published global grid feature (full), `--grid zeros`
+# and the grid read per query (`--grid-features local`). Each full run is scored by `neraf eval`
+# on the held-out split and on the experiments' new positions (40 random microphones, synth seed
+# 2), with the other two as --ablation-runs and the baselines given the same RIRs; scripts/
+# raf_gap.py's summary (means over seeds, SE over seeds, per-RIR SEs) goes to
+# DIR/grid_few_shot_F.json, and DIR/grid_few_shot.png plots the paired differences against F for
+# every fraction measured in DIR.
+# Usage: scripts/grid_few_shot.sh [F [DIR]]   (F default 0.25; DIR default build/grid_few_shot;
+#        NERAF=build/neraf). A run or evaluation already in DIR is kept.
+# Trains 1 + 9 runs (two at a time, one thread each; the vision run once per DIR) and makes 3
+# evaluations: 14 min for the first fraction and 10 for each further one on a 2-core Intel Xeon
+# with AMX (2026-12-07, nothing else running).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+F=${1:-0.25}
+DIR=${2:-build/grid_few_shot}
+NERAF=${NERAF:-build/neraf}
+awk -v f="$F" 'BEGIN { exit !(f == f + 0 && f > 0 && f <= 1) }' ||
+  { echo "grid_few_shot: the fraction F must be a number in (0, 1] (as neraf train --audio-fraction), not '$F'" >&2; exit 2; }
+[ -x "$NERAF" ] || { echo "grid_few_shot: $NERAF: no such program; build it with scripts/build.sh" >&2; exit 1; }
+/usr/bin/python3 -c 'import numpy, matplotlib' 2>/dev/null || {
+  echo "grid_few_shot: /usr/bin/python3 lacks numpy or matplotlib; install them with: apt-get install python3-matplotlib" >&2
+  exit 1
+}
+D=$DIR/data
+R=$DIR/runs
+mkdir -p "$R"
+synth() { # NAME ARGS...: the experiments' occluded room and its new positions
+  [ -f "$D/$1/synth_info.json" ] || "$NERAF" synth --preset occluded --out "$D/$1" --force --quiet "${@:2}" >/dev/null
+}
+synth occluded --seed 1
+synth occluded_novel --mics random --mic-count 40 --seed 2 --gain-from "$D/occluded"
+train() { # NAME ARGS...
+  local run=$R/$1
+  [ -f "$run/done" ] && return
+  "$NERAF" train --out "$run" --force --quiet "${@:2}" >"$run.log" 2>&1 ||
+    { echo "grid_few_shot: training $run failed; see $run.log" >&2; exit 1; }
+  touch "$run/done"
+}
+train vision --data "$D/occluded" --modality vision --seed 1
+declare -A VARIANT=([full]="" [grid_zeros]="--grid zeros" [features_local]="--grid-features local")
+pids=()
+for s in 1 2 3; do
+  for v in full grid_zeros features_local; do
+    # shellcheck disable=SC2086 # VARIANT holds zero or two words
+    train "${v}_f${F}_s$s" --data "$D/occluded" --modality audio --vision-run "$R/vision" \
+      --steps 1500 --seed "$s" --audio-fraction "$F" --threads 1 ${VARIANT[$v]} &
+    pids+=($!)
+    [ ${#pids[@]} -lt 2 ] || { wait "${pids[0]}"; pids=("${pids[@]:1}"); }
+  done
+done
+for p in "${pids[@]}"; do wait "$p"; done
+evals=()
+for s in 1 2 3; do
+  json=$DIR/eval_f${F}_s$s.json
+  [ -f "$json" ] || "$NERAF" eval --run "$R/full_f${F}_s$s" --skip-vision --no-images --quiet \
+    --novel-data "$D/occluded_novel" --images "$DIR/csv_f${F}_s$s" --json "$json" \
+    --ablation-runs "$R/grid_zeros_f${F}_s$s,$R/features_local_f${F}_s$s" >/dev/null
+  evals+=("$json")
+done
+PYTHONPATH=scripts /usr/bin/python3 - "$DIR" "$F" "${evals[@]}" <<'EOF'
+import json, os, sys, time
+from experiments_report import machine
+from raf_gap import summarise_evals
+out, fraction, evals = sys.argv[1], sys.argv[2], sys.argv[3:]
+result = {"command": f"scripts/grid_few_shot.sh {fraction} {out}",
+          "machine": f"{machine()}, {os.cpu_count()} cores",
+          "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+          "full": summarise_evals(evals)}
+path = os.path.join(out, f"grid_few_shot_{fraction}.json")
+with open(path + ".tmp", "w") as f:
+    json.dump(result, f, indent=1)
+os.replace(path + ".tmp", path)
+print("grid_few_shot: wrote", path)
+
+# The plot covers every fraction measured so far in DIR.
+import glob
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+runs = {}
+for p in glob.glob(os.path.join(out, "grid_few_shot_*.json")):
+    with open(p) as f:
+        runs[float(os.path.basename(p)[len("grid_few_shot_"):-len(".json")])] = json.load(f)["full"]
+fractions = sorted(runs)
+metrics = [("t60_error_pct", "T60 error (%)"), ("c50_error_db", "C50 error (dB)"), ("edt_error_s", "EDT error (s)")]
+others = [("grid_zeros", "zero grid"), ("features_local", "grid read per query"), ("linear", "linear"), ("nearest", "nearest")]
+fig, axes = plt.subplots(2, 3, figsize=(13, 7), sharex=True, layout="constrained")
+for row, (part, title) in enumerate([("held_out", "held-out split"), ("novel", "new positions")]):
+    for col, (key, label) in enumerate(metrics):
+        ax = axes[row][col]
+        for other, name in others:
+            d = [runs[x][part][next(k for k in runs[x][part] if k.startswith("neraf_minus_" + other))][key]
+                 for x in fractions]
+            ax.errorbar([100 * x for x in fractions], [e["mean_difference"] for e in d],
+                        yerr=[2 * e["se_over_seeds"] for e in d], marker="o", capsize=3, label=f"full - {name}")
+        ax.axhline(0, color="grey", lw=0.8)
+        ax.set_title(f"{title}: {label}")
+        ax.set_xticks([100 * x for x in fractions])
+        if col == 0:
+            ax.set_ylabel("paired difference, full - other")
+        if row == 1:
+            ax.set_xlabel("training RIRs used (%)")
+axes[0][0].legend(fontsize=8)
+fig.suptitle("occluded room: the published grid (full) minus each other method; below 0 = full better; "
+             "bars: 2 SE over 3 seeds")
+png = os.path.join(out, "grid_few_shot.png")
+fig.savefig(png + ".tmp.png", dpi=110, bbox_inches="tight")
+os.replace(png + ".tmp.png", png)
+print("grid_few_shot: wrote", png)
+EOF
