@@ -155,9 +155,10 @@ for row, (part, title) in enumerate([("held_out", "held-out split"), ("novel", "
     for col, (key, label) in enumerate(metrics):
         ax = axes[row][col]
         for other, name in others:
+            xs = [x for x in fractions if any(k.startswith("neraf_minus_" + other) for k in runs[x][part])]
             d = [runs[x][part][next(k for k in runs[x][part] if k.startswith("neraf_minus_" + other))][key]
-                 for x in fractions]
-            ax.errorbar([100 * x for x in fractions], [e["mean_difference"] for e in d],
+                 for x in xs]
+            ax.errorbar([100 * x for x in xs], [e["mean_difference"] for e in d],
                         yerr=[2 * e["se_over_seeds"] for e in d], marker="o", capsize=3, label=f"full - {name}")
         ax.axhline(0, color="grey", lw=0.8)
         ax.set_title(f"{title}: {label}")
