@@ -108,7 +108,7 @@ def per_rir(folder, part_csv, method):  # {rir_id: row}
         return {r["rir_id"]: r for r in csv.DictReader(f) if r["method"] == method}
 
 
-def paired(a, b):  # a, b: (folder, method) per seed -> a - b as summarise_evals writes it
+def paired(a, b, part_csv):  # a, b: (folder, method) per seed -> a - b as summarise_evals writes it
     summary = {}
     for k in ERRORS:
         d, se = [], []
@@ -128,8 +128,8 @@ open_grid = (f"csv_open_f{fraction}_s{{s}}", "neraf")
 zeros = (f"csv_f{fraction}_s{{s}}", f"grid_zeros_f{fraction}_s{{s}}")
 for part, part_csv in [("held_out", "audio_per_rir.csv"), ("novel", "audio_novel_per_rir.csv")]:
     summary = result["full"][part]
-    summary["neraf_minus_open_grid"] = paired(full, open_grid)
-    summary["open_grid_minus_grid_zeros"] = paired(open_grid, zeros)
+    summary["neraf_minus_open_grid"] = paired(full, open_grid, part_csv)
+    summary["open_grid_minus_grid_zeros"] = paired(open_grid, zeros, part_csv)
 result["open_grid"] = "the full model on the grid of the room without its partition (control)"
 path = os.path.join(out, f"grid_few_shot_{fraction}.json")
 with open(path + ".tmp", "w") as f:
