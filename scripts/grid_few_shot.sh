@@ -46,8 +46,8 @@ train() { # NAME ARGS...
 }
 train vision --data "$D/occluded" --modality vision --seed 1
 # The control: the grid of the same room without its partition. neraf refuses a vision run of
-# another room (its manifest's normalisation differs: the cameras avoid the partition, so they
-# stand elsewhere: 1 % in scale, 3 cm in the centre), so a linked copy of the run carries this
+# another room (its manifest names other pictures, and the cameras, which avoid the partition,
+# stand elsewhere: 1 % in scale, 3 cm at the centre), so a linked copy of the run carries this
 # room's manifest; the grid is then read up to 6 cm off, a third of a voxel.
 if [ ! -f "$D/open/synth_info.json" ]; then
   "$NERAF" synth --preset occluded --print-scene |
