@@ -15,33 +15,22 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 DIR=${1:-build/audio_average}
 NERAF=${NERAF:-build/neraf}
-[ -x "$NERAF" ] || { echo "audio_average: $NERAF: no such program; build it with scripts/build.sh" >&2; exit 1; }
-/usr/bin/python3 -c 'import numpy' 2>/dev/null || {
-  echo "audio_average: /usr/bin/python3 has no numpy; install it with: apt-get install python3-numpy" >&2
-  exit 1
-}
 D=$DIR/data
 R=$DIR/runs
+STUDY=audio_average
+# shellcheck source=scripts/study_lib.sh
+. scripts/study_lib.sh
+study_check_tools numpy python3-numpy
 mkdir -p "$R"
-synth() {  # NAME ARGS...
-  [ -f "$D/$1/synth_info.json" ] || "$NERAF" synth --preset furnished_room --out "$D/$1" --force --quiet "${@:2}" >/dev/null
-}
-synth raf_furnished --seed 1
-synth novel400 --mics random --mic-count 200 --seed 4 --gain-from "$D/raf_furnished"
-train() {  # NAME ARGS...
-  local run=$R/$1
-  [ -f "$run/done" ] && return
-  "$NERAF" train --out "$run" --force --quiet "${@:2}" >"$run.log" 2>&1 ||
-    { echo "audio_average: training $run failed; see $run.log" >&2; exit 1; }
-  touch "$run/done"
-}
-train vision --data "$D/raf_furnished" --modality vision --seed 1
+synth_once furnished_room raf_furnished --seed 1
+synth_once furnished_room novel400 --mics random --mic-count 200 --seed 4 --gain-from "$D/raf_furnished"
+train_once vision --data "$D/raf_furnished" --modality vision --seed 1
 VARIANTS=(base avg50 avg25)
 declare -A AVERAGE=([base]=0 [avg50]=0.5 [avg25]=0.25)
 for s in 1 2 3; do
   pids=()
   for v in "${VARIANTS[@]}"; do
-    train "${v}_s$s" --data "$D/raf_furnished" --modality audio --vision-run "$R/vision" \
+    train_once "${v}_s$s" --data "$D/raf_furnished" --modality audio --vision-run "$R/vision" \
       --steps 1500 --seed "$s" --threads 1 --audio-average "${AVERAGE[$v]}" &
     pids+=($!)
     [ ${#pids[@]} -lt 2 ] || { wait "${pids[0]}"; pids=("${pids[@]:1}"); }

@@ -24,27 +24,16 @@ DIR=${2:-build/grid_few_shot}
 NERAF=${NERAF:-build/neraf}
 awk -v f="$F" 'BEGIN { exit !(f == f + 0 && f > 0 && f <= 1) }' ||
   { echo "grid_few_shot: the fraction F must be a number in (0, 1] (as neraf train --audio-fraction), not '$F'" >&2; exit 2; }
-[ -x "$NERAF" ] || { echo "grid_few_shot: $NERAF: no such program; build it with scripts/build.sh" >&2; exit 1; }
-/usr/bin/python3 -c 'import numpy, matplotlib' 2>/dev/null || {
-  echo "grid_few_shot: /usr/bin/python3 lacks numpy or matplotlib; install them with: apt-get install python3-matplotlib" >&2
-  exit 1
-}
 D=$DIR/data
 R=$DIR/runs
+STUDY=grid_few_shot
+# shellcheck source=scripts/study_lib.sh
+. scripts/study_lib.sh
+study_check_tools "numpy, matplotlib" python3-matplotlib
 mkdir -p "$R"
-synth() { # NAME ARGS...: the experiments' occluded room and its new positions
-  [ -f "$D/$1/synth_info.json" ] || "$NERAF" synth --preset occluded --out "$D/$1" --force --quiet "${@:2}" >/dev/null
-}
-synth occluded --seed 1
-synth occluded_novel --mics random --mic-count 40 --seed 2 --gain-from "$D/occluded"
-train() { # NAME ARGS...
-  local run=$R/$1
-  [ -f "$run/done" ] && return
-  "$NERAF" train --out "$run" --force --quiet "${@:2}" >"$run.log" 2>&1 ||
-    { echo "grid_few_shot: training $run failed; see $run.log" >&2; exit 1; }
-  touch "$run/done"
-}
-train vision --data "$D/occluded" --modality vision --seed 1
+synth_once occluded occluded --seed 1
+synth_once occluded occluded_novel --mics random --mic-count 40 --seed 2 --gain-from "$D/occluded"
+train_once vision --data "$D/occluded" --modality vision --seed 1
 # The control: the grid of the same room without its partition. neraf refuses a vision run of
 # another room (its manifest names other pictures, and the cameras, which avoid the partition,
 # stand elsewhere: 1 % in scale, 3 cm at the centre), so a linked copy of the run carries this
@@ -54,7 +43,7 @@ if [ ! -f "$D/open/synth_info.json" ]; then
     /usr/bin/python3 -c 'import json, sys; s = json.load(sys.stdin); s["name"] += "_open"; s["furniture"] = [f for f in s["furniture"] if f["material"] != "partition"]; json.dump(s, sys.stdout)' >"$DIR/open_scene.json"
   "$NERAF" synth --scene "$DIR/open_scene.json" --seed 1 --out "$D/open" --force --quiet >/dev/null
 fi
-train vision_open --data "$D/open" --modality vision --seed 1
+train_once vision_open --data "$D/open" --modality vision --seed 1
 if [ ! -f "$R/vision_open_reg/data.json" ]; then
   rm -rf "$R/vision_open_reg"
   cp -al "$R/vision_open" "$R/vision_open_reg.tmp"
@@ -70,7 +59,7 @@ for s in 1 2 3; do
     vision=$R/vision
     [ "$v" = open_grid ] && vision=$R/vision_open_reg
     # shellcheck disable=SC2086 # VARIANT holds zero or two words
-    train "${v}_f${F}_s$s" --data "$D/occluded" --modality audio --vision-run "$vision" \
+    train_once "${v}_f${F}_s$s" --data "$D/occluded" --modality audio --vision-run "$vision" \
       --steps 1500 --seed "$s" --audio-fraction "$F" --threads 1 ${VARIANT[$v]} &
     pids+=($!)
     [ ${#pids[@]} -lt 2 ] || { wait "${pids[0]}"; pids=("${pids[@]:1}"); }
